@@ -1,0 +1,1 @@
+"""gcodekit: read, emulate and analyse G-code and NC programs."""

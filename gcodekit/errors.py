@@ -1,0 +1,153 @@
+"""Diagnostics shared by every stage: typed errors that name file:line:col.
+
+Every problem found in a program becomes a :class:`Diagnostic`.  In lenient
+mode (the default for reading and reporting) the stage records it and goes
+on; in strict mode the same diagnostic is raised as a :class:`GcodeError`
+subclass, so callers can catch gcodekit's errors without catching bugs.
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from typing import Iterable, Literal
+
+Severity = Literal["error", "warning", "info"]
+Mode = Literal["lenient", "strict"]
+MODES: tuple[str, ...] = ("lenient", "strict")
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    """One problem in a program, located by 1-based line and column."""
+
+    file: str
+    line: int
+    column: int
+    severity: Severity
+    message: str
+    text: str = ""
+
+    def __str__(self) -> str:
+        quoted = f": {self.text.strip()!r}" if self.text.strip() else ""
+        return f"{self.file}:{self.line}:{self.column}: {self.severity}: {self.message}{quoted}"
+
+    def as_dict(self) -> dict:
+        return {
+            "line": self.line,
+            "column": self.column,
+            "severity": self.severity,
+            "message": self.message,
+            "text": self.text.strip(),
+        }
+
+
+class GcodeError(Exception):
+    """Base of every error gcodekit raises about a program or a setting."""
+
+    def __init__(self, message: str, diagnostic: Diagnostic | None = None):
+        super().__init__(str(diagnostic) if diagnostic is not None else message)
+        self.diagnostic = diagnostic
+
+
+class GcodeSyntaxError(GcodeError, ValueError):
+    """The text cannot be read as words of the flavor."""
+
+
+class GcodeExpressionError(GcodeError, ValueError):
+    """An expression or parameter reference cannot be evaluated."""
+
+
+class GcodeLimitError(GcodeError, RuntimeError):
+    """A loop, recursion or size limit was reached."""
+
+
+class GcodeMachineError(GcodeError, ValueError):
+    """The machine cannot carry out a command (bad arc, missing word, ...)."""
+
+
+class ConfigError(GcodeError, ValueError):
+    """A flavor, machine preset or option is invalid."""
+
+
+_ERROR_TYPES: dict[str, type[GcodeError]] = {
+    "syntax": GcodeSyntaxError,
+    "expression": GcodeExpressionError,
+    "limit": GcodeLimitError,
+    "machine": GcodeMachineError,
+}
+
+
+class Diagnostics:
+    """Collects diagnostics for one program; raises in strict mode.
+
+    Parameters
+    ----------
+    file : str
+        Name used in every message.
+    mode : {"lenient", "strict"}, default: "lenient"
+    limit : int, default: 10000
+        Lenient mode keeps at most this many diagnostics (then counts the rest),
+        so a binary file cannot make the list unbounded.
+    """
+
+    def __init__(self, file: str = "<string>", mode: str = "lenient", limit: int = 10_000):
+        self.file = file
+        self.mode = check_choice("mode", mode, MODES)
+        self.limit = limit
+        self.items: list[Diagnostic] = []
+        self.dropped = 0
+
+    def report(
+        self,
+        line: int,
+        column: int,
+        message: str,
+        text: str = "",
+        *,
+        severity: Severity = "error",
+        kind: str = "syntax",
+    ) -> Diagnostic:
+        """Record a diagnostic; in strict mode an error is raised instead."""
+        diag = Diagnostic(self.file, int(line), int(column), severity, message, text)
+        if self.mode == "strict" and severity == "error":
+            raise _ERROR_TYPES[kind](message, diag)
+        if len(self.items) < self.limit:
+            self.items.append(diag)
+        else:
+            self.dropped += 1
+        return diag
+
+    def warn(self, line: int, column: int, message: str, text: str = "") -> Diagnostic:
+        return self.report(line, column, message, text, severity="warning")
+
+    def extend(self, diagnostics: Iterable[Diagnostic]) -> None:
+        for d in diagnostics:
+            self.report(d.line, d.column, d.message, d.text, severity=d.severity)
+
+    @property
+    def errors(self) -> list[Diagnostic]:
+        return [d for d in self.items if d.severity == "error"]
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+    def __iter__(self):
+        return iter(self.items)
+
+
+def did_you_mean(word: str, options: Iterable[str]) -> str:
+    """A ' (did you mean X?)' suffix, or '' when nothing is close."""
+    close = difflib.get_close_matches(word, list(options), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def check_choice(name: str, value: str, options: Iterable[str]) -> str:
+    """Validate a string option, listing the choices when it is wrong."""
+    options = tuple(options)
+    if value not in options:
+        raise ConfigError(
+            f"{name}={value!r} is not one of {', '.join(map(repr, options))}"
+            + did_you_mean(str(value), options)
+        )
+    return value

@@ -1,0 +1,346 @@
+"""Parse stage: :class:`~gcodekit.read.Blocks` to a :class:`CommandTable`.
+
+Blocks holding at most one code (nearly every line of a slicer's output)
+are parsed in bulk with NumPy; compound blocks go through :mod:`.split`.
+The motion mode (G0/G1/G2/G3) is modal: a block of axis words alone moves
+in the last mode set, which is a forward fill over the rows.
+
+Examples
+--------
+>>> from gcodekit.read import read_text
+>>> from gcodekit.parse import GcodeParser
+>>> table = GcodeParser("rs274ngc").parse(read_text("G1 X1 F100\\nY2\\n"))
+>>> [str(table.command(i)) for i in range(len(table))]
+['G1 F100 X1', ' Y2']
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import Diagnostics
+from ..read import Blocks
+from ..syntax import Flavor, load_flavor
+from .commands import Kind
+from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
+from .table import MOTION_NONE, MOTION_OF_NAME, NAME_ID, CommandTable
+
+_G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
+_KEEP = 255  # "this row does not set the motion mode"
+_AXIS_IDX = np.array([ord(c) - 65 for c in sorted(AXIS_LETTERS)])
+
+
+class GcodeParser:
+    """Turn blocks into typed command rows for one flavor.
+
+    Parameters
+    ----------
+    flavor : Flavor or str
+    diagnostics : Diagnostics, default: a new lenient collector
+        Receives unknown codes, repeated words and moves without a motion mode.
+
+    The parser keeps the modal motion mode between calls, so a long program
+    can be parsed chunk by chunk.
+    """
+
+    def __init__(self, flavor: Flavor | str, diagnostics: Diagnostics | None = None):
+        self.flavor = load_flavor(flavor) if isinstance(flavor, str) else flavor
+        self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
+        self.motion = MOTION_NONE
+        self._n_letter = ord(self.flavor.line_number_letter) if self.flavor.line_number_letter else -1
+        self._modal = self.flavor.block_split == "modal"
+        self._name_cache: dict[int, int] = {}
+        self._unknown_reported: set[str] = set()
+
+    # -- public ---------------------------------------------------------------
+
+    def parse(self, blocks: Blocks) -> CommandTable:
+        """Commands of ``blocks``, continuing the modal state of earlier calls."""
+        n_blocks = len(blocks)
+        wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
+        is_code = (wl == _G) | (wl == _M)
+        is_param = ~is_code & (wl != self._n_letter)
+        n_codes = np.bincount(wb[is_code], minlength=n_blocks)
+        has_param = np.bincount(wb[is_param], minlength=n_blocks) > 0
+        has_comment = np.bincount(blocks.comment_block, minlength=n_blocks) > 0
+
+        compound = n_codes >= 2
+        if blocks.extras:
+            compound[list(blocks.extras)] = True
+        if self._modal:
+            compound |= self._axis_words_on_non_consumer(blocks, is_code, is_param, n_codes)
+        elif self.flavor.block_split == "sequential":
+            compound |= has_param & (n_codes == 1) & self._params_before_code(wb, is_code, n_blocks)
+        simple = ~compound & ((n_codes == 1) | has_param | has_comment)
+
+        fast = self._simple_rows(blocks, simple, is_code, is_param)
+        slow = self._compound_rows(blocks, np.flatnonzero(compound))
+        rows = _merge_rows(fast, slow)
+        rows["line"] = blocks.block_line[rows["block"]]
+        self._classify(rows)
+        return self._table(blocks, rows)
+
+    def _table(self, blocks: Blocks, rows: dict) -> CommandTable:
+        block = rows["block"]
+        first_row = np.full(len(blocks), -1, np.int64)
+        first_row[block[::-1]] = np.arange(block.size)[::-1]
+        comment_rows = first_row[blocks.comment_block]
+        parts = rows["parts_by_row"]
+        named = {i: p.named for i, p in parts.items() if p.named is not None}
+        deleted = [first_row[b] for b, x in blocks.extras.items() if x.deleted and first_row[b] >= 0]
+        return CommandTable(
+            line=rows["line"].astype(np.int32),
+            kind=rows["kind"],
+            letter=rows["letter"],
+            number=rows["number"],
+            name=rows["name"],
+            motion=rows["motion"],
+            params=rows["params"],
+            comment_rows=comment_rows.astype(np.int32),
+            comment_offsets=blocks.comment_offsets,
+            comment_data=blocks.comment_data,
+            named=named,
+            deleted=np.array(sorted(deleted), np.int64),
+        )
+
+    # -- bulk path ------------------------------------------------------------
+
+    def _axis_words_on_non_consumer(self, blocks, is_code, is_param, n_codes) -> np.ndarray:
+        """Blocks like ``G90 X0``: one code that does not take the axis words."""
+        wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
+        axis = is_param & np.isin(wl, np.array([ord(c) for c in AXIS_LETTERS], np.uint8))
+        has_axis = np.bincount(wb[axis], minlength=len(blocks)) > 0
+        code_rows = np.flatnonzero(is_code)
+        consumer = np.zeros(len(blocks), bool)
+        names = self._name_ids(wl[code_rows], wv[code_rows])
+        consumer_ids = np.array([NAME_ID[n] for n in AXIS_CONSUMERS if n in NAME_ID])
+        consumer[wb[code_rows]] = np.isin(names, consumer_ids)
+        return has_axis & (n_codes == 1) & ~consumer
+
+    @staticmethod
+    def _params_before_code(wb, is_code, n_blocks) -> np.ndarray:
+        """GER: ``X1 G1 Y2`` is two statements, so it needs the splitter."""
+        first_word = np.full(n_blocks, -1)
+        first_code = np.full(n_blocks, -1)
+        idx = np.arange(wb.size)
+        first_word[wb[::-1]] = idx[::-1]
+        codes = np.flatnonzero(is_code)
+        first_code[wb[codes][::-1]] = codes[::-1]
+        return first_word < first_code
+
+    def _simple_rows(self, blocks: Blocks, simple: np.ndarray, is_code, is_param) -> dict:
+        wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
+        rows_blocks = np.flatnonzero(simple)
+        n = rows_blocks.size
+        row_of_block = np.full(len(blocks), -1, np.int64)
+        row_of_block[rows_blocks] = np.arange(n)
+        letter = np.zeros(n, np.uint8)
+        number = np.full(n, -1, np.int32)
+        code_words = np.flatnonzero(is_code & simple[wb])
+        r = row_of_block[wb[code_words]]
+        letter[r] = wl[code_words]
+        number[r] = np.round(wv[code_words] * 10).astype(np.int32)
+
+        pw = np.flatnonzero(is_param & simple[wb])
+        prow = row_of_block[wb[pw]]
+        pletter = wl[pw].astype(np.int64) - 65
+        # A lone T word is the command itself (printer tool change, RS274 tool select).
+        t_words = pw[(wl[pw] == _T) & (letter[prow] == 0)]
+        if t_words.size:
+            tr = row_of_block[wb[t_words]]
+            letter[tr] = _T
+            number[tr] = np.round(wv[t_words] * 10).astype(np.int32)
+            keep = ~((wl[pw] == _T) & np.isin(prow, tr))
+            pw, prow, pletter = pw[keep], prow[keep], pletter[keep]
+        table = np.full((26, n), np.nan)
+        table[pletter, prow] = wv[pw]
+        self._first_of_repeats(blocks, table, pw, prow, pletter, n)
+        present = np.flatnonzero(np.bincount(pletter, minlength=26))
+        params = {chr(65 + k): table[k].copy() for k in present}
+        return {
+            "block": rows_blocks,
+            "sub": np.zeros(n, np.int32),
+            "letter": letter,
+            "number": number,
+            "params": params,
+        }
+
+    def _first_of_repeats(self, blocks: Blocks, table, pw, prow, pletter, n_rows) -> None:
+        """A letter given twice in a block: report it and keep the first value."""
+        if not pw.size:
+            return
+        counts = np.bincount(prow * 26 + pletter, minlength=n_rows * 26)
+        for key in np.flatnonzero(counts > 1).tolist():
+            row, k = divmod(key, 26)
+            words = pw[(prow == row) & (pletter == k)]
+            table[k, row] = blocks.word_value[words[0]]
+            line = int(blocks.block_line[blocks.word_block[words[1]]])
+            self.diagnostics.report(line, int(blocks.word_col[words[1]]),
+                                    f"more than one {chr(65 + k)} word in the block; the first is used",
+                                    severity="error" if self._modal else "warning")
+
+    # -- compound blocks ------------------------------------------------------
+
+    def _compound_rows(self, blocks: Blocks, which: np.ndarray) -> dict:
+        rows: list[tuple[int, int, Part]] = []
+        starts = np.searchsorted(blocks.word_block, which)
+        ends = np.searchsorted(blocks.word_block, which, side="right")
+        for b, lo, hi in zip(which.tolist(), starts.tolist(), ends.tolist()):
+            words = [(chr(blocks.word_letter[k]), float(blocks.word_value[k])) for k in range(lo, hi)]
+            extra = blocks.extras.get(b)
+            line = int(blocks.block_line[b])
+            if extra is not None:
+                words += [(f, 0.0) for f, _ in extra.flags]
+            parts, problems = split_block(words, self.flavor, self.flavor.line_number_letter)
+            for message in problems:
+                self.diagnostics.report(line, 1, message, severity="error" if self._modal else "warning")
+            if extra is not None and extra.named is not None:
+                parts = [Part("@", named=extra.named[:2])] + parts
+            if extra is not None and extra.code_value is not None and parts:
+                parts[0].params["value"] = extra.code_value
+            if not parts:
+                parts = [Part("")]
+            for sub, part in enumerate(parts):
+                rows.append((b, sub, part))
+        n = len(rows)
+        letters = sorted({k for _, _, p in rows for k in p.params})
+        params = {k: np.full(n, np.nan) for k in letters}
+        for i, (_, _, p) in enumerate(rows):
+            for k, v in p.params.items():
+                params[k][i] = v
+        return {
+            "block": np.array([b for b, _, _ in rows], np.int64),
+            "sub": np.array([s for _, s, _ in rows], np.int32),
+            "letter": np.array([ord(p.letter) if p.letter else 0 for _, _, p in rows], np.uint8),
+            "number": np.array([round(p.number * 10) if p.letter in ("G", "M", "T") else -1
+                                for _, _, p in rows], np.int32),
+            "params": params,
+            "parts": [p for _, _, p in rows],
+        }
+
+    # -- classification -------------------------------------------------------
+
+    def _name_ids(self, letters: np.ndarray, values_or_tenths: np.ndarray, tenths: bool = False) -> np.ndarray:
+        """Normalized-name ids for codes given by letter and number."""
+        numbers = values_or_tenths if tenths else np.round(values_or_tenths * 10)
+        numbers = np.where((letters == _G) | (letters == _M), numbers, 0)
+        keys = letters.astype(np.int64) * 1_000_000 + numbers.astype(np.int64)
+        uniq, inverse = np.unique(keys, return_inverse=True)
+        ids = np.empty(uniq.size, np.uint8)
+        for i, key in enumerate(uniq.tolist()):
+            if key not in self._name_cache:
+                letter, number = divmod(key, 1_000_000)
+                name = code_name(self.flavor, chr(letter), number / 10) if letter else ""
+                self._name_cache[key] = NAME_ID.get(name, 0)
+            ids[i] = self._name_cache[key]
+        return ids[inverse]
+
+    def _classify(self, t: dict) -> None:
+        """Fill name, motion and kind of every row."""
+        letter, number, params = t["letter"], t["number"], t["params"]
+        n = letter.size
+        name = self._name_ids(letter, number, tenths=True)
+        name[(letter == _T) | (letter == _NAMED)] = 0
+        self._report_unknown(t, name)
+
+        sets = np.full(n, _KEEP, np.uint8)
+        for mname, mode in MOTION_OF_NAME.items():
+            sets[name == NAME_ID[mname]] = mode
+        if "cancel_cycle" in NAME_ID:
+            sets[name == NAME_ID["cancel_cycle"]] = MOTION_NONE
+        g53 = name == NAME_ID["machine_coordinates"]
+        for i in np.flatnonzero(g53 & (letter != 0)):
+            part = t.get("parts_by_row", {}).get(int(i))
+            if part is not None and part.motion:
+                sets[i] = MOTION_OF_NAME.get(part.motion, _KEEP)
+        motion = _forward_fill_modes(sets, self.motion)
+        if n:
+            self.motion = int(motion[-1])
+
+        def has(letters: str) -> np.ndarray:
+            out = np.zeros(n, bool)
+            for c in letters:
+                if c in params:
+                    out |= ~np.isnan(params[c])
+            return out
+
+        has_axes, has_e, has_s, has_f = has("XYZABCUVW"), has("E"), has("S"), has("F")
+        is_motion_name = np.isin(name, [NAME_ID[m] for m in MOTION_OF_NAME])
+        implicit = (letter == 0) & has_axes if self._modal else np.zeros(n, bool)
+        moving = (is_motion_name | implicit) & (has_axes | has_e)
+        arc = (motion == 3) | (motion == 4)
+
+        kind = np.full(n, Kind.CONFIG, np.uint8)
+        kind[letter == _G] = Kind.G
+        kind[letter == _M] = Kind.M
+        kind[(letter == 0) & has_f] = Kind.FEED_RATE
+        kind[(letter == 0) & has_s & ~has_f] = Kind.MILL
+        kind[(letter == 0) & ~(has_f | has_s | has_axes | has_e)] = Kind.COMMENT
+        kind[is_motion_name & ~(has_axes | has_e) & has_f] = Kind.FEED_RATE
+        kind[name == NAME_ID["dwell"]] = Kind.DWELL
+        kind[name == NAME_ID["distance_absolute"]] = Kind.ABSOLUTE_POSITION
+        kind[name == NAME_ID["distance_incremental"]] = Kind.INCREMENTAL_POSITION
+        for k in range(1, 10):
+            kind[name == NAME_ID[f"work_offset_{k}"]] = Kind.WORK_COORDINATES
+        lin = moving & ~arc
+        kind[lin] = Kind.MOVE
+        kind[lin & has_s & ~has_e] = Kind.MOVE_MILL
+        kind[lin & has_e] = Kind.MOVE_EXTRUDE
+        kind[lin & has_e & ~has_axes] = Kind.EXTRUDE
+        circ = moving & arc
+        kind[circ] = Kind.ARC
+        kind[circ & has_s & ~has_e] = Kind.ARC_MILL
+        kind[circ & has_e] = Kind.ARC_EXTRUDE
+        kind[g53] = Kind.MACHINE_COORDINATES
+
+        lost = implicit & (motion == MOTION_NONE)
+        for i in np.flatnonzero(lost)[:100].tolist():
+            self.diagnostics.report(int(t["line"][i]), 1, "axis words but no motion mode (G0/G1/G2/G3) is in force")
+        kind[lost] = Kind.CONFIG
+        orphan = (letter == 0) & (has_axes | has_e) & (not self._modal)
+        for i in np.flatnonzero(orphan)[:100].tolist():
+            self.diagnostics.warn(int(t["line"][i]), 1, "words without a command are ignored by this firmware")
+        kind[orphan] = Kind.CONFIG
+        t["name"], t["motion"], t["kind"] = name, motion, kind
+
+    def _report_unknown(self, t: dict, name: np.ndarray) -> None:
+        letter, number = t["letter"], t["number"]
+        unknown = np.flatnonzero((name == 0) & ((letter == _G) | (letter == _M)))
+        for i in unknown.tolist():
+            code = chr(letter[i]) + (str(number[i] // 10) if number[i] % 10 == 0 else f"{number[i] / 10:g}")
+            if code in self._unknown_reported:
+                continue
+            self._unknown_reported.add(code)
+            self.diagnostics.warn(int(t["line"][i]), 1, f"{code} is not a {self.flavor.name} code; kept as a generic command")
+
+
+def _forward_fill_modes(sets: np.ndarray, initial: int) -> np.ndarray:
+    """Motion mode of each row: the last mode set at or before it."""
+    idx = np.where(sets != _KEEP, np.arange(sets.size), -1)
+    np.maximum.accumulate(idx, out=idx)
+    out = np.where(idx >= 0, sets[np.maximum(idx, 0)], initial).astype(np.uint8)
+    return out
+
+
+def _merge_rows(fast: dict, slow: dict) -> dict:
+    """Rows of both paths in block order (their blocks never overlap)."""
+    if slow["block"].size == 0:
+        merged = fast
+        merged["parts_by_row"] = {}
+    else:
+        at = np.searchsorted(fast["block"], slow["block"])
+        merged = {k: np.insert(fast[k], at, slow[k]) for k in ("block", "sub", "letter", "number")}
+        n = merged["block"].size
+        slow_rows = at + np.arange(at.size)
+        fast_rows = np.setdiff1d(np.arange(n), slow_rows, assume_unique=True)
+        params = {}
+        for k in sorted(set(fast["params"]) | set(slow["params"])):
+            col = np.full(n, np.nan)
+            if k in fast["params"]:
+                col[fast_rows] = fast["params"][k]
+            if k in slow["params"]:
+                col[slow_rows] = slow["params"][k]
+            params[k] = col
+        merged["params"] = params
+        merged["parts_by_row"] = dict(zip(slow_rows.tolist(), slow["parts"]))
+    return merged

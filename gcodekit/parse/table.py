@@ -1,0 +1,206 @@
+"""Parse stage output: commands as columns, one row per command.
+
+Rows are in execution order.  Parameters are float columns keyed by word
+letter (NaN where a command has no such word); letters used by few rows are
+kept sparse.  :meth:`CommandTable.command` builds the typed object of a row.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..syntax.flavor import COMMANDS
+from .commands import COMMAND_CLASSES, Command, Kind
+
+#: Normalized command names by id; id 0 is "" (no code or unknown code).
+NAMES: tuple[str, ...] = ("",) + tuple(sorted(COMMANDS))
+NAME_ID: dict[str, int] = {n: i for i, n in enumerate(NAMES)}
+
+#: Motion modes carried by the ``motion`` column.
+MOTION_NONE, MOTION_RAPID, MOTION_LINEAR, MOTION_CW, MOTION_CCW = range(5)
+MOTION_NAMES = ("", "rapid", "feed", "arc_cw", "arc_ccw")
+MOTION_OF_NAME = {"rapid": MOTION_RAPID, "linear": MOTION_LINEAR, "arc_cw": MOTION_CW, "arc_ccw": MOTION_CCW}
+
+_SPARSE_BELOW = 0.02  # a parameter present in fewer rows than this is kept sparse
+
+
+@dataclass
+class SparseColumn:
+    """A mostly-NaN column stored as sorted row indices and values."""
+
+    rows: np.ndarray
+    values: np.ndarray
+    size: int
+
+    def dense(self) -> np.ndarray:
+        out = np.full(self.size, np.nan)
+        out[self.rows] = self.values
+        return out
+
+    def at(self, i: int) -> float:
+        k = np.searchsorted(self.rows, i)
+        return float(self.values[k]) if k < self.rows.size and self.rows[k] == i else float("nan")
+
+
+@dataclass
+class CommandTable:
+    """Columns of parsed commands.
+
+    Attributes
+    ----------
+    line : ndarray of int32
+        1-based source line of each command.
+    kind : ndarray of uint8
+        :class:`~gcodekit.parse.commands.Kind` of each command.
+    letter : ndarray of uint8
+        Code letter (``ord('G')``, ``ord('M')``, ``ord('T')``), ``ord('@')``
+        for named commands, 0 for none.
+    number : ndarray of int32
+        Code number times ten (``G92.1`` is 921), -1 for none.
+    name : ndarray of uint8
+        Index into :data:`NAMES`.
+    motion : ndarray of uint8
+        Motion mode in force for the command (see :data:`MOTION_NAMES`).
+    params : dict of str to ndarray or SparseColumn
+    comment_rows : ndarray of int32
+        Row of each comment (sorted); a row may have several.
+    comment_offsets : ndarray of int64
+        Comment ``k`` is ``comment_data[offsets[k]:offsets[k+1]]`` (UTF-8).
+    comment_data : bytes
+    named : dict of int to tuple
+        Named commands by row: ``(name, argument text)``.
+    deleted : ndarray of int64
+        Rows from block-delete (``/``) lines, skipped when the machine's
+        block-delete switch is on.
+    """
+
+    line: np.ndarray
+    kind: np.ndarray
+    letter: np.ndarray
+    number: np.ndarray
+    name: np.ndarray
+    motion: np.ndarray
+    params: dict[str, np.ndarray | SparseColumn]
+    comment_rows: np.ndarray
+    comment_offsets: np.ndarray
+    comment_data: bytes
+    named: dict[int, tuple[str, str]] = field(default_factory=dict)
+    deleted: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+
+    def __len__(self) -> int:
+        return int(self.line.size)
+
+    def param(self, letter: str) -> np.ndarray:
+        """Dense float column of a word letter (all NaN if never used)."""
+        col = self.params.get(letter)
+        if col is None:
+            return np.full(len(self), np.nan)
+        return col.dense() if isinstance(col, SparseColumn) else col
+
+    def code(self, i: int) -> str:
+        letter, number = int(self.letter[i]), int(self.number[i])
+        if letter == ord("@"):
+            return self.named[i][0]
+        if letter == 0:
+            return ""
+        return chr(letter) + (str(number // 10) if number % 10 == 0 else f"{number // 10}.{number % 10}")
+
+    def comment_of(self, i: int) -> str | None:
+        """Comment text of row ``i`` (several comments joined by a space), or None."""
+        lo, hi = np.searchsorted(self.comment_rows, [i, i + 1])
+        if lo == hi:
+            return None
+        return " ".join(self.comment(k) for k in range(lo, hi))
+
+    def comment(self, k: int) -> str:
+        a, b = self.comment_offsets[k], self.comment_offsets[k + 1]
+        return self.comment_data[a:b].decode("utf-8", "replace").strip()
+
+    def command(self, i: int) -> Command:
+        """The typed :class:`Command` of row ``i``."""
+        n = len(self)
+        if not -n <= i < n:
+            raise IndexError(f"command {i} out of range for {n} commands")
+        i %= n
+        params = {}
+        for letter, col in self.params.items():
+            v = col.at(i) if isinstance(col, SparseColumn) else float(col[i])
+            if v == v:
+                params[letter] = v
+        cls = COMMAND_CLASSES[Kind(int(self.kind[i]))]
+        named = self.named.get(i)
+        return cls(
+            code=self.code(i),
+            params=params,
+            line=int(self.line[i]),
+            comment=self.comment_of(i),
+            name=NAMES[int(self.name[i])],
+            text=named[1] if named else "",
+        )
+
+    def compact(self) -> "CommandTable":
+        """Store rarely used parameters sparsely (saves memory on big programs)."""
+        n = len(self)
+        for letter, col in list(self.params.items()):
+            if isinstance(col, SparseColumn):
+                continue
+            rows = np.flatnonzero(~np.isnan(col))
+            if rows.size < _SPARSE_BELOW * n:
+                self.params[letter] = SparseColumn(rows.astype(np.int64), col[rows], n)
+        return self
+
+    @classmethod
+    def concat(cls, parts: list["CommandTable"]) -> "CommandTable":
+        """Join consecutive chunks, one column at a time to bound memory."""
+        if len(parts) == 1:
+            return parts[0].compact()
+        sizes = [len(p) for p in parts]
+        shift = np.cumsum([0] + sizes[:-1])
+        letters = sorted({k for p in parts for k in p.params})
+        params: dict[str, np.ndarray | SparseColumn] = {}
+        n = sum(sizes)
+        for letter in letters:
+            pieces = []
+            for p, s in zip(parts, sizes):
+                col = p.params.get(letter)
+                pieces.append(np.full(s, np.nan) if col is None else
+                              (col.dense() if isinstance(col, SparseColumn) else col))
+            dense = np.concatenate(pieces)
+            for p in parts:
+                p.params.pop(letter, None)
+            params[letter] = dense
+        named = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.named.items()}
+        table = cls(
+            line=_cat(parts, "line"),
+            kind=_cat(parts, "kind"),
+            letter=_cat(parts, "letter"),
+            number=_cat(parts, "number"),
+            name=_cat(parts, "name"),
+            motion=_cat(parts, "motion"),
+            params=params,
+            comment_rows=np.concatenate([p.comment_rows + s for p, s in zip(parts, shift)]),
+            comment_offsets=_concat_offsets([p.comment_offsets for p in parts]),
+            comment_data=b"".join(p.comment_data for p in parts),
+            named=named,
+            deleted=np.concatenate([p.deleted + s for p, s in zip(parts, shift)]),
+        )
+        assert len(table) == n
+        return table.compact()
+
+
+def _concat_offsets(offsets: list[np.ndarray]) -> np.ndarray:
+    out = [offsets[0]]
+    base = offsets[0][-1]
+    for o in offsets[1:]:
+        out.append(o[1:] + base)
+        base += o[-1]
+    return np.concatenate(out)
+
+
+def _cat(parts: list[CommandTable], attr: str) -> np.ndarray:
+    out = np.concatenate([getattr(p, attr) for p in parts])
+    for p in parts:
+        setattr(p, attr, None)
+    return out

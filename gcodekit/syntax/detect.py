@@ -1,0 +1,204 @@
+"""Syntax stage: guess a program's flavor from its first lines.
+
+Each flavor file's ``[detect]`` rules turn evidence into points (see
+:func:`detect_flavor`); the highest score wins and ties go to the higher
+``priority``.  Like xarray's ``guess_can_open``, detection only looks at the
+head of the file, so it is cheap enough to run on every open.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+from dataclasses import dataclass
+
+from .flavor import Flavor
+from .loader import list_flavors, load_flavor
+
+#: Detection reads at most this much of the text it is given.
+HEAD_CHARS = 64 * 1024
+HEAD_LINES = 4000
+
+#: Points per piece of evidence.  A header match (slicer banner, dialect-only
+#: command) outweighs any number of shared codes a short head can hold.
+HEADER_POINTS = 10.0
+EXTENSION_POINTS = 3.0
+E_WORD_POINTS = 2.0
+CODE_POINTS = 1.0
+COMMENT_POINTS = 1.0
+#: Below this best score the evidence is too thin and a default is used.
+MIN_SCORE = 3.0
+#: Candidates within this many points of the winner are reported as close.
+CLOSE_POINTS = 1.0
+
+_COMMENTS = re.compile(r"\([^()\n]*\)|;[^\n]*")
+_GM_CODE = re.compile(r"(?<![A-Za-z_#<])([GgMm])[ \t]*0*(\d+(?:\.\d+)?)")
+# Extended commands and wizards start a line with two letters: PRINT_START, Pocket.
+_NAME = re.compile(r"^[ \t]*([A-Za-z_]{2}\w*)", re.M)
+_E_WORD = re.compile(r"^[^\n]*\b[Gg]0*[0-3]\b[^\n]*[ \t][Ee][-+]?\.?\d", re.M)
+
+
+@dataclass(frozen=True)
+class Detection:
+    """The outcome of :func:`detect_flavor`.
+
+    Attributes
+    ----------
+    name : str
+        The chosen flavor.
+    score : float
+        Its points (0 when a default was used for lack of evidence).
+    reasons : tuple of str
+        The evidence for the choice, in words.
+    candidates : tuple of (str, float)
+        Every flavor that scored, best first.
+    """
+
+    name: str
+    score: float
+    reasons: tuple[str, ...]
+    candidates: tuple[tuple[str, float], ...]
+
+
+@dataclass(frozen=True)
+class _Rules:
+    name: str
+    priority: int
+    header: tuple[re.Pattern[str], ...]
+    codes: frozenset[str]
+    extensions: tuple[str, ...]
+    comment: str
+    extrudes: bool
+
+
+@functools.lru_cache(maxsize=1)
+def _all_rules() -> tuple[_Rules, ...]:
+    rules = []
+    for name in list_flavors():
+        flavor = load_flavor(name)
+        d = flavor.detect
+        rules.append(
+            _Rules(
+                name,
+                d.priority,
+                tuple(re.compile(p) for p in d.header),
+                frozenset(d.codes),
+                d.extensions,
+                d.comment,
+                "e" in flavor.words.values(),
+            )
+        )
+    return tuple(rules)
+
+
+def _codes_in(text: str) -> set[str]:
+    """Normalized codes (``G1``, ``M104``, ``PRINT_START``) outside comments."""
+    bare = _COMMENTS.sub("", text)
+    codes = {f"{m[1].upper()}{m[2]}" for m in _GM_CODE.finditer(bare)}
+    codes.update(m[1].upper() for m in _NAME.finditer(bare))
+    return codes
+
+
+def _comment_style(lines: list[str]) -> str:
+    semi = sum(";" in line for line in lines)
+    paren = sum("(" in line for line in lines)
+    return ";" if semi > paren else "(" if paren > semi else ""
+
+
+def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None) -> Detection:
+    """Guess the flavor of a program from its head and file name.
+
+    Points per flavor: 10 for each ``[detect] header`` regex found (slicer
+    banners such as ``;FLAVOR:Marlin``, dialect-only commands such as
+    Klipper's ``PRINT_START``), 3 for a typical file extension, 2 for E words
+    on moves if the flavor extrudes, 1 for each typical code present and 1
+    for the usual comment style.  The best score wins; equal scores go to
+    the higher ``priority``.  Below 3 points the evidence is too thin and a
+    default is used: ``"marlin"`` for programs with E words on moves and
+    without parenthesised comments, ``"rs274ngc"`` (the reference language)
+    otherwise.
+
+    Parameters
+    ----------
+    text_head : str
+        The start of the program; only the first 64 KiB and 4000 lines are
+        read.
+    filename : str or path-like, default: None
+        Its file name, whose suffix is evidence too.
+
+    Returns
+    -------
+    Detection
+        The name, its score, the reasons and every candidate that scored.
+
+    See Also
+    --------
+    guess_flavor : the same, returning the loaded Flavor.
+
+    Examples
+    --------
+    A Cura banner names the firmware.
+
+    >>> d = detect_flavor(";FLAVOR:Marlin\\nM82\\nG1 X1 E0.5\\n")
+    >>> d.name, d.candidates[0][0]
+    ('marlin', 'marlin')
+    """
+    lines = text_head[:HEAD_CHARS].splitlines()[:HEAD_LINES]
+    head = "\n".join(lines)
+    suffix = os.path.splitext(os.fspath(filename))[1].lower() if filename is not None else ""
+    present = _codes_in(head)
+    style = _comment_style(lines)
+    e_words = _E_WORD.search(_COMMENTS.sub("", head)) is not None
+
+    scored: list[tuple[float, int, str, list[str]]] = []
+    for rules in _all_rules():
+        score, reasons = 0.0, []
+        for pattern in rules.header:
+            if pattern.search(head):
+                score += HEADER_POINTS
+                reasons.append(f"header matches /{pattern.pattern}/")
+        if suffix and suffix in rules.extensions:
+            score += EXTENSION_POINTS
+            reasons.append(f"file extension {suffix}")
+        if e_words and rules.extrudes:
+            score += E_WORD_POINTS
+            reasons.append("E words on moves")
+        typical = sorted(rules.codes & present)
+        if typical:
+            score += CODE_POINTS * len(typical)
+            reasons.append(f"typical codes {', '.join(typical)}")
+        if style and style == rules.comment:
+            score += COMMENT_POINTS
+            reasons.append(f"{style!r} comments")
+        scored.append((score, rules.priority, rules.name, reasons))
+
+    scored.sort(key=lambda s: (-s[0], -s[1], s[2]))
+    candidates = tuple((name, score) for score, _, name, _ in scored if score > 0)
+    best_score, _, best, reasons = scored[0]
+    if best_score < MIN_SCORE:
+        default = "marlin" if e_words and style != "(" else "rs274ngc"
+        why = "E words on moves" if default == "marlin" else "the reference language"
+        return Detection(
+            default,
+            0.0,
+            (f"no flavor scored {MIN_SCORE:g} points; default {default!r} ({why})",),
+            candidates,
+        )
+    close = [(n, s) for n, s in candidates[1:] if s >= best_score - CLOSE_POINTS]
+    if close:
+        listed = ", ".join(f"{n} ({s:g})" for n, s in close)
+        by = "priority" if close[0][1] == best_score else "score"
+        reasons = [*reasons, f"close candidates: {listed}; chose {best!r} by {by}"]
+    return Detection(best, best_score, tuple(reasons), candidates)
+
+
+def guess_flavor(text_head: str, filename: str | os.PathLike[str] | None = None) -> Flavor:
+    """Load the flavor :func:`detect_flavor` chooses.
+
+    Examples
+    --------
+    >>> guess_flavor("(Part name: Dome)\\n#TRAFO ON\\nG00 X1 Y2 Z3\\n").name
+    'beckhoff_ded'
+    """
+    return load_flavor(detect_flavor(text_head, filename).name)

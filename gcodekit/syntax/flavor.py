@@ -1,0 +1,185 @@
+"""Syntax stage: the Flavor record that describes one G-code dialect.
+
+A flavor is data, loaded from ``flavors/<name>.toml`` by :mod:`.loader`.  It
+says how text is cut into words (comments, separators, case, line numbers)
+and what each code and word means in gcodekit's normalized vocabulary
+(:data:`COMMANDS`, :data:`PARAMETERS`), which is all later stages look at.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Mapping
+
+#: How the words of one block become commands.
+#: ``modal``: RS274NGC, one command per modal group, run in the
+#: interpreter's order of execution; ``single``: printer firmware, the first
+#: G/M/T word is the command and every other word its parameter;
+#: ``sequential``: GER, every G/M code starts a new statement in text order.
+BLOCK_SPLITS = ("modal", "single", "sequential")
+
+#: Normalized command names a flavor's ``[codes]`` table may map to.
+COMMANDS = frozenset(
+    """
+    rapid linear arc_cw arc_ccw dwell
+    plane_xy plane_zx plane_yz units_inch units_mm
+    distance_absolute distance_incremental arc_distance_absolute arc_distance_incremental
+    feed_inverse_time feed_per_minute feed_per_rev
+    machine_coordinates
+    work_offset_1 work_offset_2 work_offset_3 work_offset_4 work_offset_5
+    work_offset_6 work_offset_7 work_offset_8 work_offset_9
+    set_position clear_position_offset suspend_position_offset restore_position_offset
+    home home_secondary store_home store_home_secondary
+    extrude_absolute extrude_relative firmware_retract firmware_unretract
+    set_flow set_speed_factor
+    tool_change spindle_cw spindle_ccw spindle_off
+    coolant_mist coolant_flood coolant_off
+    program_stop optional_stop program_end
+    tool_length_offset tool_length_offset_dynamic cancel_tool_length
+    cutter_comp_off cutter_comp_left cutter_comp_right
+    cancel_cycle exact_stop path_blending
+    set_hotend_temp wait_hotend_temp set_bed_temp wait_bed_temp set_chamber_temp
+    fan_on fan_off
+    set_max_accel set_max_feed set_accel set_jerk set_junction_deviation wait_moves
+    mesh_level motors_off message progress
+    weld_start laser_on laser_off
+    probe
+    """.split()
+)
+
+#: Normalized parameter names a flavor's ``[words]`` table may map to.
+PARAMETERS = frozenset(
+    "x y z a b c u v w e feed speed tool p q r i j k l d h line_number".split()
+)
+
+
+@dataclass(frozen=True)
+class DetectRules:
+    """Evidence that a program is written in this flavor.
+
+    Attributes
+    ----------
+    header : tuple of str
+        Regular expressions searched in the first lines (slicer banners,
+        ``;FLAVOR:`` lines); a match is strong evidence.
+    codes : tuple of str
+        Codes typical of the dialect (``M82``, ``SET_VELOCITY_LIMIT``).
+    extensions : tuple of str
+        File suffixes typical of the dialect (``.ngc``, ``.nc``).
+    comment : str
+        The comment style the dialect mostly uses: ``";"``, ``"("`` or ``""``.
+    priority : int
+        Tie-breaker: higher wins when the evidence is equal.
+    """
+
+    header: tuple[str, ...] = ()
+    codes: tuple[str, ...] = ()
+    extensions: tuple[str, ...] = ()
+    comment: str = ""
+    priority: int = 0
+
+
+@dataclass(frozen=True)
+class Flavor:
+    """One dialect: how to read its text and what its codes mean.
+
+    Attributes (syntax)
+    -------------------
+    line_comments : tuple of str
+        Characters that start a comment running to the end of the line.
+    paren_comments : bool
+        ``( ... )`` is a comment.
+    multiline_comments : bool
+        A parenthesised comment may span lines (GER).
+    statement_separators : tuple of str
+        Characters that end a statement inside a line (GER's ``;``).  A
+        character cannot be both a separator and a line comment.
+    line_number_letter : str
+        Letter of the optional block number word, ``"N"`` or ``""``.
+    block_delete : bool
+        A leading ``/`` marks a block that may be skipped.
+    checksum : bool
+        Host-protocol checksums ``*nn`` end the line (Marlin, RepRapFirmware).
+    case_sensitive : bool
+        Lower-case letters are not words (Klipper's extended commands keep
+        their case either way).
+    spaces_in_numbers : bool
+        Whitespace inside a word is ignored (RS274NGC: ``X 1 0`` is ``X10``).
+    parameters : bool
+        ``#`` parameters and ``[...]`` expressions are part of the language.
+    percent_delimiter : bool
+        A line holding only ``%`` starts or ends the program.
+    block_split : {"modal", "single", "sequential"}
+        See :data:`BLOCK_SPLITS`.
+    string_codes : frozenset of str
+        Codes whose remaining text is one string argument (``M117 Hello``).
+    extended_commands : bool
+        Klipper-style ``NAME KEY=VALUE`` commands are accepted.
+    wizards : bool
+        GER wizard calls (a name of two or more letters then arguments).
+    code_assignments : bool
+        A code may carry a value after ``=`` (Beckhoff ``M60=1``); the value
+        becomes the command's ``value`` parameter.
+    directive_prefix : str
+        Lines starting with this text are controller directives kept as
+        named commands (Beckhoff ``#TRAFO ON``); ``""`` for none.
+
+    Attributes (semantics)
+    ----------------------
+    words : mapping of str to str
+        Word letter to normalized parameter (:data:`PARAMETERS`).
+    codes : mapping of str to str
+        Code such as ``"G0"`` or ``"M104"`` to normalized command
+        (:data:`COMMANDS`); numbers are written without leading zeros.
+    units : {"mm", "inch"}
+        Units in force at program start.
+    extrusion : {"absolute", "relative", ""}
+        E mode at program start; ``""`` when the dialect does not extrude.
+    rapid_is_feed : bool
+        G0 moves at the programmed feed (Marlin), not at the rapid rate.
+    layer_comments : tuple of str
+        Regular expressions on comment text marking a new layer.
+    feature_comment : str
+        Regular expression whose first group names the feature being made.
+    detect : DetectRules
+    """
+
+    name: str
+    description: str = ""
+    line_comments: tuple[str, ...] = (";",)
+    paren_comments: bool = False
+    multiline_comments: bool = False
+    statement_separators: tuple[str, ...] = ()
+    line_number_letter: str = "N"
+    block_delete: bool = False
+    checksum: bool = False
+    case_sensitive: bool = False
+    spaces_in_numbers: bool = False
+    parameters: bool = False
+    percent_delimiter: bool = False
+    block_split: str = "single"
+    string_codes: frozenset[str] = frozenset()
+    extended_commands: bool = False
+    wizards: bool = False
+    code_assignments: bool = False
+    directive_prefix: str = ""
+    words: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    codes: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    units: str = "mm"
+    extrusion: str = ""
+    rapid_is_feed: bool = False
+    layer_comments: tuple[str, ...] = ()
+    feature_comment: str = ""
+    detect: DetectRules = DetectRules()
+
+    def command(self, code: str) -> str | None:
+        """Normalized command name of a code such as ``"G1"``, or None."""
+        return self.codes.get(code)
+
+    def codes_for(self, command: str) -> tuple[str, ...]:
+        """Every code of this flavor that means ``command``."""
+        return tuple(c for c, n in self.codes.items() if n == command)
+
+    def __repr__(self) -> str:
+        return f"Flavor({self.name!r})"

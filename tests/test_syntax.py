@@ -1,0 +1,212 @@
+"""Syntax stage: flavor files load, validate strictly, inherit and detect."""
+
+from pathlib import Path
+from types import MappingProxyType
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gcodekit.errors import ConfigError
+from gcodekit.syntax import (
+    BLOCK_SPLITS,
+    COMMANDS,
+    PARAMETERS,
+    Flavor,
+    detect_flavor,
+    list_flavors,
+    load_flavor,
+)
+from gcodekit.syntax.detect import HEAD_CHARS, guess_flavor
+from gcodekit.syntax.loader import FLAVOR_DIR
+
+FLAVORS = list_flavors()
+
+
+def test_bundled_flavors():
+    assert {"rs274ngc", "fanuc", "marlin", "klipper", "reprapfirmware", "grbl",
+            "beckhoff_ded", "ger", "freecad"} <= set(FLAVORS)
+
+
+@pytest.mark.parametrize("name", FLAVORS)
+def test_every_flavor_loads(name):
+    flavor = load_flavor(name)
+    assert isinstance(flavor, Flavor) and flavor.name == name and flavor.description
+    assert flavor.block_split in BLOCK_SPLITS
+    assert set(flavor.codes.values()) <= COMMANDS
+    assert set(flavor.words.values()) <= PARAMETERS
+    assert isinstance(flavor.codes, MappingProxyType) and isinstance(flavor.words, MappingProxyType)
+    assert isinstance(flavor.line_comments, tuple) and isinstance(flavor.string_codes, frozenset)
+    assert flavor.codes_for("rapid") == ("G0",)
+    assert load_flavor(name) is flavor  # cached
+
+
+def test_flavor_semantics():
+    ngc = load_flavor("rs274ngc")
+    assert ngc.command("G59.3") == "work_offset_9" and ngc.command("M60") == "program_stop"
+    marlin = load_flavor("marlin")
+    assert marlin.extrusion == "absolute" and marlin.rapid_is_feed and marlin.words["E"] == "e"
+    assert "M30" in marlin.string_codes and marlin.command("M30") is None
+    ger = load_flavor("ger")
+    assert ger.statement_separators == (";",) and ";" not in ger.line_comments
+    assert ger.units == "inch" and ger.multiline_comments and ger.line_number_letter == ""
+    ded = load_flavor("beckhoff_ded")
+    assert [ded.command(c) for c in ("M60", "M61", "M62", "M63")] == ["weld_start", "laser_on", "laser_off", None]
+
+
+def test_klipper_inherits_marlin():
+    marlin, klipper = load_flavor("marlin"), load_flavor("klipper")
+    assert klipper.extended_commands and not marlin.extended_commands
+    assert klipper.command("SET_VELOCITY_LIMIT") == "set_accel"
+    assert klipper.command("G1") == "linear" and klipper.layer_comments == marlin.layer_comments
+    assert klipper.command("M205") is None and marlin.command("M205") == "set_jerk"  # removed by ""
+    assert load_flavor("reprapfirmware").command("M566") == "set_jerk"
+
+
+def test_load_by_path_and_unknown_name():
+    assert load_flavor(FLAVOR_DIR / "grbl.toml") is load_flavor("grbl")
+    assert load_flavor(str(FLAVOR_DIR / "grbl.toml")) is load_flavor("grbl")
+    with pytest.raises(ConfigError, match="did you mean 'marlin'"):
+        load_flavor("marln")
+
+
+def _write(tmp_path, text, name="bad"):
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ('name = "bad"\nline_coments = [";"]\n', r"bad\.toml: line_coments: unknown key \(did you mean 'line_comments'\?\)"),
+        ('name = "bad"\n[detect]\nextention = [".nc"]\n', r"\[detect\] extention: unknown key \(did you mean 'extensions'\?\)"),
+        ('name = "bad"\nblock_split = "modall"\n', r"block_split: 'modall' is not one of .*did you mean 'modal'"),
+        ('name = "bad"\nunits = "cm"\n', r"bad\.toml: units: 'cm' is not one of 'mm', 'inch'"),
+        ('name = "bad"\nextrusion = "relativ"\n', r"extrusion: .*did you mean 'relative'"),
+        ('name = "bad"\nchecksum = "yes"\n', r"checksum: expected true or false, got 'yes'"),
+        ('name = "bad"\n[codes]\nG1 = "lineer"\n', r"\[codes\] G1: 'lineer' is not a command name \(did you mean 'linear'\?\)"),
+        ('name = "bad"\n[codes]\nG01 = "linear"\n', r"\[codes\] G01: write codes without leading zeros: 'G1'"),
+        ('name = "bad"\n[words]\nE = "extrude"\n', r"\[words\] E: 'extrude' is not a parameter name"),
+        ('name = "bad"\nstatement_separators = [";"]\n', r"statement_separators: ';' is also in line_comments"),
+        ('name = "bad"\nlayer_comments = ["(unclosed"]\n', r"layer_comments: invalid regular expression"),
+        ('name = "bad"\nfeature_comment = "^TYPE:"\n', r"feature_comment: .* needs a \(group\)"),
+        ('name = "bad"\n[codes]\nPRINT_START = "program_stop"\n', r"PRINT_START: extended command names need extended_commands"),
+        ('name = "bad"\nline_number_letter = ""\n[words]\nN = "line_number"\n', r"\[words\] N: maps to 'line_number'"),
+        ('name = "bad"\ninherit = "marlinn"\n', r"inherit: unknown flavor 'marlinn' \(did you mean 'marlin'\?\)"),
+        ('name = "bad"\n[detect]\npriority = "high"\n', r"\[detect\] priority: expected an integer"),
+        ('name = "bad"\nunits = [\n', r"bad\.toml: invalid TOML"),
+        ('description = "no name"\n', r"name: missing required key"),
+    ],
+)
+def test_validation_errors_name_file_table_key(tmp_path, text, expected):
+    with pytest.raises(ConfigError, match=expected):
+        load_flavor(_write(tmp_path, text))
+
+
+def test_inheritance_merges_tables(tmp_path):
+    path = _write(tmp_path, """
+name = "mymarlin"
+inherit = "marlin"
+checksum = false
+layer_comments = ['^NEW_LAYER$']
+[codes]
+M600 = "program_stop"
+M73 = ""
+[detect]
+priority = 0
+""", "mymarlin")
+    mine, marlin = load_flavor(path), load_flavor("marlin")
+    assert mine.name == "mymarlin" and not mine.checksum and mine.extrusion == "absolute"
+    assert mine.command("M600") == "program_stop" and mine.command("M73") is None
+    assert mine.command("G1") == "linear" and mine.layer_comments == ("^NEW_LAYER$",)
+    assert mine.detect.priority == 0 and mine.detect.codes == marlin.detect.codes
+    assert mine.words == marlin.words
+
+
+def test_inheritance_from_sibling_and_cycles(tmp_path):
+    _write(tmp_path, 'name = "base"\nunits = "inch"\n[codes]\nG0 = "rapid"\n', "base")
+    child = _write(tmp_path, 'name = "child"\ninherit = "base"\n', "child")
+    assert load_flavor(child).units == "inch" and load_flavor(child).command("G0") == "rapid"
+    _write(tmp_path, 'name = "a"\ninherit = "b"\n', "a")
+    _write(tmp_path, 'name = "b"\ninherit = "a"\n', "b")
+    with pytest.raises(ConfigError, match="circular inheritance"):
+        load_flavor(tmp_path / "a.toml")
+
+
+def _head(path: Path) -> str:
+    with path.open(errors="replace") as fh:
+        return fh.read(HEAD_CHARS)
+
+
+def test_detect_fff_corpus(shared_dir):
+    files = sorted((shared_dir / "corpus" / "fff").glob("*.gcode"))
+    assert files
+    for path in files:
+        expected = "klipper" if path.name == "cube20_klipper.gcode" else "marlin"
+        assert detect_flavor(_head(path), path.name).name == expected, path.name
+        assert detect_flavor(_head(path)).name == expected, path.name
+
+
+def test_detect_ded_corpus(shared_dir):
+    files = sorted((shared_dir / "corpus" / "ded").glob("*.nc"))
+    assert files
+    for path in files:
+        detection = detect_flavor(_head(path), path)
+        assert detection.name == "beckhoff_ded", path.name
+        assert any("Part name" in r for r in detection.reasons)
+
+
+def test_detect_linuxcnc_corpus(shared_dir):
+    files = sorted((shared_dir / "corpus" / "linuxcnc" / "nc_files").glob("*.ngc"))
+    assert len(files) > 50
+    wrong = [p.name for p in files if detect_flavor(_head(p), p.name).name != "rs274ngc"]
+    assert wrong == []
+
+
+def test_detect_klipper_reasons_and_candidates():
+    head = "; generated by PrusaSlicer 2.5.0\nM190 S60\nPRINT_START BED=60\nM83\nG1 X1 E0.5\n"
+    detection = detect_flavor(head, "part.gcode")
+    assert detection.name == "klipper"
+    assert dict(detection.candidates)["marlin"] < detection.score
+    assert any("PRINT_START" in r for r in detection.reasons)
+
+
+def test_detect_tie_lists_candidates():
+    detection = detect_flavor("; generated by PrusaSlicer 2.5.0\nM82\nG1 X1 E0.5\n")
+    assert detection.name == "marlin"
+    assert detection.candidates[1] == ("klipper", detection.score)
+    assert any("close candidates" in r and "priority" in r for r in detection.reasons)
+
+
+def test_detect_ger_sample():
+    head = "(GER sample: a pocket\n  made by a wizard)\nG20 G90\nG00 X1.0 Y1.0; G01 Z-0.1 F10\nPocket 0.75 0.30 0.10\nM30\n"
+    assert detect_flavor(head).name == "ger"
+    assert guess_flavor(head).statement_separators == (";",)
+
+
+def test_detect_other_headers():
+    assert detect_flavor("%\nO1234 (BRACKET)\nG21 G17 G90\nG00 X0 Y0\nM30\n%\n").name == "fanuc"
+    assert detect_flavor("$H\nG21 G90\nG0 X10\n").name == "grbl"
+    assert detect_flavor(";FLAVOR:Marlin\nM82\n", "x.gcode").name == "marlin"
+
+
+@pytest.mark.parametrize(
+    ("head", "filename", "expected"),
+    [
+        ("G1 X1 E2\nG1 X2 E3\n", None, "marlin"),
+        ("(part)\nG0 X1\nG1 Y2\n", None, "rs274ngc"),
+        ("", None, "rs274ngc"),
+    ],
+)
+def test_detect_fallback(head, filename, expected):
+    detection = detect_flavor(head, filename)
+    assert detection.name == expected and detection.score == 0
+    assert "default" in detection.reasons[0]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(alphabet=st.characters(codec="utf-8"), max_size=2000), st.none() | st.text(max_size=20))
+def test_detect_never_raises(text, filename):
+    detection = detect_flavor(text, filename)
+    assert detection.name in FLAVORS
