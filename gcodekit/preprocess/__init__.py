@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Iterable, Iterator, Protocol
+from typing import Iterable, Iterator, Protocol, runtime_checkable
 
 from gcodekit.errors import Diagnostics, GcodeError
 from gcodekit.preprocess.expressions import evaluate as _evaluate
@@ -38,6 +38,7 @@ class SourceLine:
     file: str
 
 
+@runtime_checkable
 class Stage(Protocol):
     """A preprocess step: a named map from lines to lines.
 

@@ -63,7 +63,7 @@ FUNCTIONS = ("abs", "acos", "asin", "cos", "exp", "fix", "fup", "ln", "round", "
 KEYWORDS = tuple(k for k in PRECEDENCE if k.isalpha()) + FUNCTIONS + ("atan", "exists")
 _WHITESPACE = frozenset(" \t\r\n\v\f")
 _NUMBER = re.compile(r"[0-9.]+")
-_VALID_NUMBER = re.compile(r"\d+\.?\d*|\.\d+")
+_VALID_NUMBER = re.compile(r"[0-9]+\.?[0-9]*|\.[0-9]+")
 _LETTERS = re.compile(r"[a-z]+")
 
 
@@ -224,7 +224,7 @@ class _Parser:
         if c in "+-":
             operand, end = self.value(pos + 1)
             return (Negate(operand, col) if c == "-" else operand), end
-        if c.isdigit() or c == ".":
+        if c in "0123456789.":
             text = _NUMBER.match(s, pos).group()
             if not _VALID_NUMBER.fullmatch(text):
                 raise self.fail(f"bad number {text!r}", pos)
@@ -298,11 +298,12 @@ class _Parser:
     def function(self, pos: int) -> tuple[Node, int]:
         s = self.s
         col = self.code.column(pos)
-        word = self.keyword(pos)
+        # A function name is always followed by '[', so the whole run of
+        # letters is the name.
+        word = _LETTERS.match(s, pos).group()
         if word not in FUNCTIONS + ("atan", "exists"):
-            name = word or _LETTERS.match(s, pos).group()
             names = [f.upper() for f in FUNCTIONS + ("atan", "exists")]
-            raise self.fail(f"unknown function {name.upper()!r}" + did_you_mean(name.upper(), names), pos)
+            raise self.fail(f"unknown function {word.upper()!r}" + did_you_mean(word.upper(), names), pos)
         p = pos + len(word)
         if not s.startswith("[", p):
             raise self.fail(f"{word.upper()} must be followed by '['", p)

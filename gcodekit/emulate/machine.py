@@ -1,0 +1,332 @@
+"""Emulate stage: run command tables on a modal machine, producing waypoints.
+
+Most commands only move within a fixed modal state (units, distance mode,
+offsets, plane).  Runs of such commands are emulated with array code: in
+absolute mode a target coordinate is the last one given (a forward fill),
+in incremental mode it is a running sum.  Commands that change that state
+(G20/G21, G90/G91, G92, G54..., G28, G53, M82/M83, tool changes, ...) are
+few and are handled one at a time in :mod:`.modal`, between the runs.
+
+Every command gives one waypoint: its end state.  A command that moves
+through several points (G28 via its intermediate point) adds waypoints
+before its own, each pointing back to the command.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import Diagnostics
+from ..parse.commands import Kind
+from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, MOTION_RAPID, NAME_ID, CommandTable
+from . import arcs
+from .modal import SPECIAL_NAMES, ModalHandler, Waypoint
+from .presets import MachineConfig
+from .state import AXES, LINEAR, MachineState
+
+#: Float columns of the waypoint table, with their meaning and unit.
+FLOAT_COLUMNS = {
+    "x": "X, machine coordinates, mm", "y": "Y, mm", "z": "Z, mm",
+    "a": "A, degrees", "b": "B, degrees", "c": "C, degrees",
+    "de": "filament pushed by this step, mm", "feed": "feed rate in force, mm/min",
+    "distance": "path length of this step, mm", "time": "duration of this step, s",
+    "cx": "arc centre X, mm (NaN if not an arc or the helix axis)", "cy": "arc centre Y, mm",
+    "cz": "arc centre Z, mm", "spindle": "spindle speed, rpm (negative: counter-clockwise)",
+}
+SMALL_COLUMNS = {
+    "motion": (np.uint8, "0 none, 1 rapid, 2 feed, 3 arc_cw, 4 arc_ccw"),
+    "plane": (np.uint8, "17, 18 or 19"),
+    "units": (np.uint8, "program units in force: 0 mm, 1 inch"),
+    "tool": (np.int32, "tool in the spindle or active extruder"),
+    "coolant": (np.uint8, "bit 1 mist, bit 2 flood"),
+    "work_offset": (np.uint8, "1..9 for G54..G59.3"),
+}
+_MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTRUDE, Kind.MOVE_MILL,
+                           Kind.ARC_MILL, Kind.EXTRUDE}), np.uint8)
+_MILL = np.array([Kind.MILL, Kind.MOVE_MILL, Kind.ARC_MILL], np.uint8)
+_NO_FEED_WORD = np.array([Kind.M, Kind.COMMENT], np.uint8)
+
+
+class Machine:
+    """A modal machine that emulates command tables chunk by chunk.
+
+    Parameters
+    ----------
+    config : MachineConfig
+    diagnostics : Diagnostics, default: a new lenient collector
+    rapid_is_feed : bool
+        G0 moves at the modal feed (from the flavor unless the preset says).
+    """
+
+    def __init__(self, config: MachineConfig, diagnostics: Diagnostics | None = None, *,
+                 rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = ""):
+        self.config = config
+        self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
+        self.rapid_is_feed = config.rapid_is_feed if config.rapid_is_feed is not None else rapid_is_feed
+        self.state = MachineState()
+        self.state.units = 25.4 if initial_units == "inch" else 1.0
+        self.state.e_relative = initial_extrusion == "relative"
+        if config.initial_feed > 0:
+            self.state.feed = config.initial_feed
+        for code, vector in config.work_offsets.items():
+            self.state.work_offsets[_WORK_INDEX[code], : len(vector)] = vector
+        self.modal = ModalHandler(self)
+        self._warned: set[str] = set()
+
+    # -- running ----------------------------------------------------------------
+
+    def run(self, table: CommandTable) -> dict[str, np.ndarray]:
+        """Waypoint columns for ``table``: one per command plus any extra ones.
+
+        The returned dict holds the :data:`FLOAT_COLUMNS` and
+        :data:`SMALL_COLUMNS` arrays and ``command`` (row of the command each
+        waypoint belongs to) when some command added waypoints.
+        """
+        n = len(table)
+        out = {k: np.empty(n) for k in FLOAT_COLUMNS}
+        out.update({k: np.empty(n, dtype) for k, (dtype, _) in SMALL_COLUMNS.items()})
+        special = np.isin(table.name, self.modal.special_ids) | (table.letter == ord("T"))
+        special |= table.kind == Kind.MACHINE_COORDINATES
+        if self.config.block_delete and table.deleted.size:
+            special[table.deleted] = True
+        extra: list[tuple[int, Waypoint]] = []
+        cursor = 0
+        for row in np.flatnonzero(special).tolist():
+            if self.state.ended:
+                break
+            if row > cursor:
+                self._run_segment(table, cursor, row, out)
+            extra += [(row, w) for w in self.modal.apply(table, row, out)]
+            cursor = row + 1
+        if cursor < n and not self.state.ended:
+            self._run_segment(table, cursor, n, out)
+            cursor = n
+        if cursor < n:
+            self._hold(cursor, n, out)
+            self._once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
+        return _with_extra_waypoints(out, extra, n)
+
+    def _hold(self, start: int, stop: int, out: dict) -> None:
+        """Rows after the program end: nothing moves."""
+        self._fill_state(slice(start, stop), out)
+        for k, v in zip(AXES.lower(), self.state.position):
+            out[k][start:stop] = v
+        for k in ("de", "distance", "time"):
+            out[k][start:stop] = 0.0
+        for k in ("cx", "cy", "cz"):
+            out[k][start:stop] = np.nan
+        out["motion"][start:stop] = 0
+        out["spindle"][start:stop] = self.state.speed * self.state.spindle
+        out["feed"][start:stop] = self.state.feed
+
+    def _fill_state(self, rows: slice, out: dict) -> None:
+        s = self.state
+        out["plane"][rows] = s.plane
+        out["units"][rows] = 1 if s.units != 1.0 else 0
+        out["tool"][rows] = s.tool
+        out["coolant"][rows] = s.coolant
+        out["work_offset"][rows] = s.work_offset
+
+    # -- runs of plain commands ---------------------------------------------------
+
+    def _run_segment(self, t: CommandTable, start: int, stop: int, out: dict) -> None:
+        """Emulate rows ``start:stop``, none of which changes the modal state."""
+        s = self.state
+        rows = slice(start, stop)
+        n = stop - start
+        kind = t.kind[rows]
+        moving = np.isin(kind, _MOVING)
+        motion = np.where(moving, t.motion[rows], 0).astype(np.uint8)
+        offset = s.offset
+        scale = s.scale()
+        program = s.program_position()
+        position = np.empty((n, 6))
+        for ax, letter in enumerate(AXES):
+            col = t.params.get(letter)
+            if col is None:
+                position[:, ax] = s.position[ax]
+                continue
+            values = _dense(col, rows) * scale[ax]
+            values[~moving] = np.nan
+            if s.incremental:
+                position[:, ax] = program[ax] + np.cumsum(np.nan_to_num(values)) + offset[ax]
+            else:
+                position[:, ax] = _forward_fill(values, program[ax]) + offset[ax]
+        start_pos = np.vstack([s.position[None, :], position[:-1]])
+
+        feed_words = _dense(t.params["F"], rows) * s.units if "F" in t.params else np.full(n, np.nan)
+        feed_words[np.isin(kind, _NO_FEED_WORD)] = np.nan
+        if s.feed_mode == "inverse_time":
+            feed = feed_words  # 1/min, for this block only
+        else:
+            feed = _forward_fill(feed_words, s.feed)
+
+        de = self._extrusion(t, rows, moving)
+        delta = position - start_pos
+        distance = np.sqrt(np.einsum("ij,ij->i", delta[:, :3], delta[:, :3]))
+        centers = np.full((n, 3), np.nan)
+        is_arc = (motion == MOTION_CW) | (motion == MOTION_CCW)
+        if is_arc.any():
+            self._arcs(t, start, np.flatnonzero(is_arc), start_pos, position, centers, distance, offset, scale)
+        rotary = np.sqrt(np.einsum("ij,ij->i", delta[:, 3:], delta[:, 3:]))
+        time = self._durations(t, rows, kind, motion, distance, rotary, de, feed)
+
+        for ax, letter in enumerate(AXES.lower()):
+            out[letter][rows] = position[:, ax]
+        out["de"][rows] = de
+        out["feed"][rows] = feed
+        out["distance"][rows] = distance
+        out["time"][rows] = time
+        out["motion"][rows] = motion
+        out["cx"][rows], out["cy"][rows], out["cz"][rows] = centers.T
+        speed = self._spindle_speeds(t, rows, kind)
+        out["spindle"][rows] = speed * s.spindle
+        self._fill_state(rows, out)
+
+        s.position = position[-1].copy()
+        if s.feed_mode != "inverse_time":
+            s.feed = float(feed[-1])
+        s.speed = float(speed[-1])
+
+    def _extrusion(self, t: CommandTable, rows: slice, moving: np.ndarray) -> np.ndarray:
+        s = self.state
+        n = rows.stop - rows.start
+        if "E" not in t.params:
+            return np.zeros(n)
+        e = _dense(t.params["E"], rows) * s.units
+        e[~moving] = np.nan
+        if s.e_relative:
+            de = np.nan_to_num(e)
+            s.e_program += float(de.sum())
+        else:
+            target = _forward_fill(e, s.e_program)
+            de = np.diff(target, prepend=s.e_program)
+            s.e_program = float(target[-1])
+        de *= s.flow
+        s.e_total += float(de.sum())
+        return de
+
+    def _spindle_speeds(self, t: CommandTable, rows: slice, kind: np.ndarray) -> np.ndarray:
+        if "S" not in t.params:
+            return np.full(rows.stop - rows.start, self.state.speed)
+        words = _dense(t.params["S"], rows).copy()
+        words[~np.isin(kind, _MILL)] = np.nan
+        return _forward_fill(words, self.state.speed)
+
+    def _arcs(self, t, start, idx, start_pos, end_pos, centers, distance, offset, scale) -> None:
+        """Centers and lengths of the arc rows ``idx`` (relative to ``start``)."""
+        s = self.state
+        (f, g, h), (l1, l2) = arcs.PLANES[s.plane]
+        rows = idx + start
+        p0 = start_pos[idx][:, [f, g]]
+        p1 = end_pos[idx][:, [f, g]]
+        r_word = _take(t, "R", rows) * s.units
+        o1 = _take(t, l1, rows) * s.units
+        o2 = _take(t, l2, rows) * s.units
+        clockwise = t.motion[rows] == MOTION_CW
+        by_radius = ~np.isnan(r_word)
+        no_center = ~by_radius & np.isnan(o1) & np.isnan(o2)
+        for i in np.flatnonzero(no_center)[:20]:
+            self.diagnostics.report(int(t.line[rows[i]]), 1, f"arc needs {l1}/{l2} offsets or R in this plane (G{s.plane})",
+                                    kind="machine")
+        if s.arc_incremental:
+            center = p0 + np.column_stack([np.nan_to_num(o1), np.nan_to_num(o2)])
+        else:
+            center = np.column_stack([np.nan_to_num(o1) + offset[f], np.nan_to_num(o2) + offset[g]])
+        if by_radius.any():
+            c, reach = arcs.center_from_radius(p0[by_radius], p1[by_radius], r_word[by_radius], clockwise[by_radius])
+            center[by_radius] = c
+            tolerance = 0.005 if s.units == 1.0 else 0.0005 * 25.4
+            for i in np.flatnonzero(by_radius)[reach > tolerance][:20]:
+                self.diagnostics.report(int(t.line[rows[i]]), 1, "arc radius too small to reach the end point",
+                                        kind="machine")
+        turns = np.nan_to_num(_take(t, "P", rows), nan=1.0)
+        angle = arcs.sweep(p0, p1, center, clockwise, turns)
+        radius = np.hypot(*(p0 - center).T)
+        radius_end = np.hypot(*(p1 - center).T)
+        self._check_radii(t, rows, radius, radius_end, s.units)
+        rise = end_pos[idx, h] - start_pos[idx, h]
+        distance[idx] = arcs.arc_length(radius, angle, rise)
+        centers[idx, f] = center[:, 0]
+        centers[idx, g] = center[:, 1]
+
+    def _check_radii(self, t, rows, r0, r1, units) -> None:
+        # LinuxCNC rejects centre-format arcs whose end radius differs from the
+        # start radius by more than 0.0005 in / 0.01 mm and 0.1 % (interp_arc.cc).
+        tolerance = 0.0005 * 25.4 if units != 1.0 else 0.01
+        bad = (np.abs(r1 - r0) > tolerance) & (np.abs(r1 - r0) > 0.001 * r0)
+        for i in np.flatnonzero(bad)[:20]:
+            self.diagnostics.report(int(t.line[rows[i]]), 1,
+                                    f"radius to end of arc differs from radius to start by {abs(r1[i] - r0[i]):.4g} mm",
+                                    kind="machine")
+
+    def _durations(self, t, rows, kind, motion, distance, rotary, de, feed) -> np.ndarray:
+        """Time of each row: length over feed (the planner refines this later)."""
+        s = self.state
+        n = kind.size
+        time = np.zeros(n)
+        feeding = (motion == MOTION_LINEAR) | (motion == MOTION_CW) | (motion == MOTION_CCW)
+        rapid = motion == MOTION_RAPID
+        path = np.where(distance > 0, distance, np.where(rotary > 0, rotary, np.abs(de)))
+        if s.feed_mode == "inverse_time":
+            with np.errstate(divide="ignore"):
+                time[feeding] = 60.0 / feed[feeding]
+        else:
+            rate = np.where(rapid, feed if self.rapid_is_feed else self.config.rapid_feed, feed)
+            moving = feeding | rapid
+            with np.errstate(divide="ignore", invalid="ignore"):
+                time[moving] = path[moving] / (rate[moving] / 60.0)
+            bad = moving & ~(rate > 0) & (path > 0)
+            if bad.any():
+                first = int(np.flatnonzero(bad)[0])
+                self._once("feed", int(t.line[rows][first]), "move with no feed rate (F) in force; its time is unknown")
+                time[bad] = np.nan
+        dwell = kind == Kind.DWELL
+        if dwell.any():
+            time[dwell] = self._dwell_times(t, rows, dwell)
+        return time
+
+    def _dwell_times(self, t, rows, dwell) -> np.ndarray:
+        p = _dense(t.params["P"], rows)[dwell] if "P" in t.params else np.full(int(dwell.sum()), np.nan)
+        s_word = _dense(t.params["S"], rows)[dwell] if "S" in t.params else np.full(p.size, np.nan)
+        unit = 0.001 if self.config.dwell_p_unit == "ms" else 1.0
+        return np.where(~np.isnan(p), p * unit, np.nan_to_num(s_word))
+
+    def _once(self, key: str, line: int, message: str) -> None:
+        if key not in self._warned:
+            self._warned.add(key)
+            self.diagnostics.warn(line, 1, message)
+
+
+_WORK_INDEX = {c: i + 1 for i, c in enumerate(("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3"))}
+
+
+def _dense(col, rows: slice) -> np.ndarray:
+    if isinstance(col, np.ndarray):
+        return col[rows].copy()
+    return col.dense()[rows]
+
+
+def _take(t: CommandTable, letter: str, rows: np.ndarray) -> np.ndarray:
+    col = t.params.get(letter)
+    if col is None:
+        return np.full(rows.size, np.nan)
+    return (col if isinstance(col, np.ndarray) else col.dense())[rows]
+
+
+def _forward_fill(values: np.ndarray, initial: float) -> np.ndarray:
+    """Each NaN replaced by the last number before it (``initial`` at the start)."""
+    idx = np.where(np.isnan(values), -1, np.arange(values.size))
+    np.maximum.accumulate(idx, out=idx)
+    return np.where(idx >= 0, values[np.maximum(idx, 0)], initial)
+
+
+def _with_extra_waypoints(out: dict, extra: list, n: int) -> dict:
+    if not extra:
+        return out
+    rows = np.array([r for r, _ in extra])
+    for key, arr in out.items():
+        values = [w.values.get(key, arr[r]) if r < n else 0 for r, w in extra]
+        out[key] = np.insert(arr, rows, np.array(values, dtype=arr.dtype))
+    out["command"] = np.insert(np.arange(n), rows, rows).astype(np.int64)
+    return out

@@ -1,0 +1,208 @@
+"""Emulate stage: the commands that change the machine's modal state.
+
+These are rare (a few per layer or per tool), so each is handled alone, in
+plain Python, in the interpreter's words: units, distance modes, planes,
+work offsets (G54-G59.3), axis offsets (G92 family), homing (G28/G30),
+machine-coordinate moves (G53), extrusion modes, tools, spindle, coolant
+and program end.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..parse.table import MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, NAMES, CommandTable
+from .state import AXES, MachineState
+
+if TYPE_CHECKING:
+    from .machine import Machine
+
+SPECIAL_NAMES = frozenset(
+    """units_inch units_mm distance_absolute distance_incremental arc_distance_absolute
+    arc_distance_incremental plane_xy plane_zx plane_yz feed_inverse_time feed_per_minute
+    feed_per_rev set_position clear_position_offset suspend_position_offset
+    restore_position_offset home home_secondary store_home store_home_secondary
+    extrude_absolute extrude_relative set_flow tool_change spindle_cw spindle_ccw spindle_off
+    coolant_mist coolant_flood coolant_off program_end machine_coordinates
+    firmware_retract firmware_unretract""".split()
+) | {f"work_offset_{k}" for k in range(1, 10)}
+
+_SIMPLE = {
+    "units_inch": ("units", 25.4), "units_mm": ("units", 1.0),
+    "distance_absolute": ("incremental", False), "distance_incremental": ("incremental", True),
+    "arc_distance_absolute": ("arc_incremental", False), "arc_distance_incremental": ("arc_incremental", True),
+    "plane_xy": ("plane", 17), "plane_zx": ("plane", 18), "plane_yz": ("plane", 19),
+    "feed_inverse_time": ("feed_mode", "inverse_time"), "feed_per_minute": ("feed_mode", "per_minute"),
+    "feed_per_rev": ("feed_mode", "per_rev"),
+    "extrude_absolute": ("e_relative", False), "extrude_relative": ("e_relative", True),
+}
+
+
+@dataclass
+class Waypoint:
+    """An intermediate point a command passes through (column -> value)."""
+
+    values: dict[str, float] = field(default_factory=dict)
+
+
+class ModalHandler:
+    """Applies one state-changing command to a :class:`Machine`'s state."""
+
+    def __init__(self, machine: "Machine"):
+        self.machine = machine
+        self.special_ids = np.array(sorted(NAME_ID[n] for n in SPECIAL_NAMES), np.uint8)
+
+    @property
+    def state(self) -> MachineState:
+        return self.machine.state
+
+    def apply(self, t: CommandTable, row: int, out: dict) -> list[Waypoint]:
+        """Run command ``row`` and write its waypoint; return points passed on the way."""
+        s = self.state
+        name = NAMES[int(t.name[row])]
+        params = t.command(row).params
+        line = int(t.line[row])
+        before = s.position.copy()
+        motion, extra = MOTION_NONE, []
+        if self.machine.config.block_delete and row in set(t.deleted.tolist()):
+            self._write(out, row, before, MOTION_NONE)
+            return []
+        if "F" in params and chr(int(t.letter[row])) != "M":
+            s.feed = params["F"] * s.units
+        if name in _SIMPLE:
+            attr, value = _SIMPLE[name]
+            setattr(s, attr, value)
+        elif name.startswith("work_offset_"):
+            s.work_offset = int(name.rsplit("_", 1)[1])
+        elif name == "set_position":
+            self._set_position(params, line, t)
+        elif name == "clear_position_offset":
+            s.g92[:] = 0.0
+            s.g92_saved = None
+        elif name == "suspend_position_offset":
+            s.g92_saved, s.g92 = s.g92.copy(), np.zeros_like(s.g92)
+        elif name == "restore_position_offset":
+            if s.g92_saved is not None:
+                s.g92 = s.g92_saved.copy()
+        elif name in ("home", "home_secondary"):
+            motion, extra = MOTION_RAPID, self._home(params, name == "home_secondary")
+        elif name == "store_home":
+            s.home = s.position.copy()
+        elif name == "store_home_secondary":
+            s.home_secondary = s.position.copy()
+        elif name == "machine_coordinates":
+            motion = self._machine_move(params, int(t.motion[row]), line)
+        elif name == "set_flow":
+            s.flow = params.get("S", 100.0) / 100.0
+        elif name == "tool_change" or chr(int(t.letter[row])) == "T":
+            self._tool(t, row, params)
+        elif name in ("spindle_cw", "spindle_ccw", "spindle_off"):
+            s.spindle = {"spindle_cw": 1, "spindle_ccw": -1, "spindle_off": 0}[name]
+            s.speed = params.get("S", s.speed)
+        elif name in ("coolant_mist", "coolant_flood", "coolant_off"):
+            s.coolant = {"coolant_mist": s.coolant | 1, "coolant_flood": s.coolant | 2, "coolant_off": 0}[name]
+        elif name == "program_end":
+            self._end_program()
+        for w in extra:
+            self._fill_passing(w, before)
+            before = np.array([w.values[k] for k in AXES.lower()])
+        self._write(out, row, before, motion)
+        return extra
+
+    # -- commands -----------------------------------------------------------------
+
+    def _set_position(self, params: dict, line: int, t: CommandTable) -> None:
+        """G92: offset the axes so the current point has the given coordinates."""
+        s = self.state
+        scale = s.scale()
+        given = [ax for ax, letter in enumerate(AXES) if letter in params]
+        if not given and "E" not in params and self.machine.config.home_mode == "stored":
+            self.machine.diagnostics.report(line, 1, "G92 needs at least one axis word", kind="machine")
+        for ax in given:
+            s.g92[ax] = s.position[ax] - s.work_offsets[s.work_offset][ax] - params[AXES[ax]] * scale[ax]
+        if "E" in params:
+            s.e_program = params["E"] * s.units
+
+    def _home(self, params: dict, secondary: bool) -> list[Waypoint]:
+        s = self.state
+        stored = s.home_secondary if secondary else s.home
+        given = [ax for ax, letter in enumerate(AXES) if letter in params]
+        if self.machine.config.home_mode == "select":
+            for ax in given or [0, 1, 2]:
+                s.position[ax] = stored[ax]
+            return []
+        extra = []
+        if given:
+            via = s.position.copy()
+            program = s.program_position()
+            scale = s.scale()
+            for ax in given:
+                value = params[AXES[ax]] * scale[ax]
+                via[ax] = (program[ax] + value if s.incremental else value) + s.offset[ax]
+            extra.append(Waypoint({k: v for k, v in zip(AXES.lower(), via)} | {"motion": MOTION_RAPID}))
+            s.position[:] = np.where(np.isin(np.arange(6), given), stored, via)
+        else:
+            s.position = stored.copy()
+        return extra
+
+    def _machine_move(self, params: dict, motion: int, line: int) -> int:
+        """G53: move to machine coordinates in this block only."""
+        s = self.state
+        if motion not in (MOTION_RAPID, MOTION_LINEAR):
+            self.machine.diagnostics.report(line, 1, "G53 needs G0 or G1 in force", kind="machine")
+            return MOTION_NONE
+        if s.incremental:
+            self.machine.diagnostics.report(line, 1, "G53 is not allowed in incremental mode (G91)", kind="machine")
+        scale = s.scale()
+        for ax, letter in enumerate(AXES):
+            if letter in params:
+                s.position[ax] = params[letter] * scale[ax]
+        return motion
+
+    def _tool(self, t: CommandTable, row: int, params: dict) -> None:
+        s = self.state
+        if chr(int(t.letter[row])) == "T":
+            number = int(round(t.number[row] / 10))
+            if self.machine.config.tool_change_on == "T":
+                s.tool = number
+            s.selected_tool = number
+        else:
+            s.tool = int(params.get("T", s.selected_tool))
+
+    def _end_program(self) -> None:
+        """M2/M30: LinuxCNC resets these modes and stops reading the program."""
+        s = self.state
+        s.work_offset, s.plane, s.incremental, s.feed_mode = 1, 17, False, "per_minute"
+        s.spindle, s.coolant = 0, 0
+        s.ended = True
+
+    # -- output -------------------------------------------------------------------
+
+    def _fill_passing(self, w: Waypoint, before: np.ndarray) -> None:
+        s = self.state
+        point = np.array([w.values[k] for k in AXES.lower()])
+        distance = float(np.linalg.norm((point - before)[:3]))
+        w.values.update(distance=distance, time=distance / (self.machine.config.rapid_feed / 60.0),
+                        de=0.0, cx=np.nan, cy=np.nan, cz=np.nan)
+
+    def _write(self, out: dict, row: int, before: np.ndarray, motion: int) -> None:
+        s = self.state
+        for k, v in zip(AXES.lower(), s.position):
+            out[k][row] = v
+        distance = float(np.linalg.norm((s.position - before)[:3]))
+        rate = s.feed if (motion == MOTION_LINEAR or self.machine.rapid_is_feed) else self.machine.config.rapid_feed
+        out["distance"][row] = distance
+        out["time"][row] = distance / (rate / 60.0) if distance and rate > 0 else 0.0
+        out["de"][row] = 0.0
+        out["feed"][row] = s.feed
+        out["motion"][row] = motion
+        out["cx"][row] = out["cy"][row] = out["cz"][row] = np.nan
+        out["spindle"][row] = s.speed * s.spindle
+        out["plane"][row] = s.plane
+        out["units"][row] = 1 if s.units != 1.0 else 0
+        out["tool"][row] = s.tool
+        out["coolant"][row] = s.coolant
+        out["work_offset"][row] = s.work_offset

@@ -1,0 +1,359 @@
+"""Emulate stage output: Operation, the commands paired with their process data.
+
+An Operation holds the parsed commands (a :class:`CommandTable`) and, once a
+machine has run them, a table of waypoints: one per command (its end
+state), plus intermediate points of commands that pass through several.
+``operation.commands[i]`` and ``operation.process_data[i]`` describe the
+same step and are built from the columns when indexed.
+
+Examples
+--------
+>>> import gcodekit
+>>> op = gcodekit.gcode_to_operation("G21 G90\\nG1 X10 F600\\nG1 Y10\\n", machine="linuxcnc")
+>>> op.get_bounds()["max"], round(op.get_statistics()["time_s"], 3)
+([10.0, 10.0, 0.0], 2.0)
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+
+from ..errors import Diagnostics
+from ..parse.commands import Command, Kind
+from ..parse.table import MOTION_NAMES, NAMES, CommandTable
+from .machine import FLOAT_COLUMNS, SMALL_COLUMNS
+from .state import MM_PER_INCH
+
+if TYPE_CHECKING:
+    from ..syntax import Flavor
+    from .presets import MachineConfig
+
+
+@dataclass(frozen=True)
+class ProcessData:
+    """What the machine model predicts at the end of one step.
+
+    Attributes
+    ----------
+    location : tuple of float
+        Machine X, Y, Z (mm) and A, B, C (degrees).
+    feed_rate : float
+        Feed rate in force, mm/min.
+    elapsed_time : float
+        Time since the program started, s.
+    distance : float
+        Path length of the step, mm.
+    duration : float
+        Time the step takes, s.
+    motion : str
+        ``""``, ``"rapid"``, ``"feed"``, ``"arc_cw"`` or ``"arc_ccw"``.
+    """
+
+    location: tuple[float, float, float, float, float, float]
+    feed_rate: float
+    elapsed_time: float
+    distance: float
+    duration: float
+    motion: str
+
+
+@dataclass(frozen=True)
+class AdditiveProcessData(ProcessData):
+    """Process data of a deposition step.
+
+    Attributes
+    ----------
+    deposited_volume : float
+        Material deposited by the step, mm^3 (filament length times its area).
+    bead_area : float
+        Cross-section of the deposited bead, mm^2 (volume over path length;
+        0 for travel).
+    extruder_type : str
+        ``"filament"`` for FFF, ``"screw"`` for pellet LFAM, ``"wire"`` for DED.
+    """
+
+    deposited_volume: float = 0.0
+    bead_area: float = 0.0
+    extruder_type: str = "filament"
+
+
+@dataclass(frozen=True)
+class SubtractiveProcessData(ProcessData):
+    """Process data of a milling step.
+
+    Attributes
+    ----------
+    spindle_speed : float
+        rpm, negative when counter-clockwise.
+    removed_volume : float or None
+        None until material removal is modelled.
+    """
+
+    spindle_speed: float = 0.0
+    removed_volume: float | None = None
+
+
+class _LazyList(Sequence):
+    """A read-only list whose items are made from columns when indexed."""
+
+    def __init__(self, size: int, make):
+        self._size = size
+        self._make = make
+
+    def __len__(self) -> int:
+        return self._size
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self._make(k) for k in range(*i.indices(self._size))]
+        if not -self._size <= i < self._size:
+            raise IndexError(f"index {i} out of range for {self._size} items")
+        return self._make(i % self._size)
+
+    def __repr__(self) -> str:
+        return f"<{self._size} items>"
+
+
+class Operation:
+    """Commands of a program and, after emulation, their process data.
+
+    Parameters
+    ----------
+    commands : CommandTable
+    waypoints : dict of str to ndarray, optional
+        Columns from :meth:`Machine.run`; None before emulation.
+    file : str
+    flavor : Flavor
+    machine : MachineConfig, optional
+    diagnostics : Diagnostics
+    """
+
+    process_data_class: type[ProcessData] = ProcessData
+
+    def __init__(self, commands: CommandTable, waypoints: dict[str, np.ndarray] | None = None, *,
+                 file: str = "<string>", flavor: "Flavor | None" = None,
+                 machine: "MachineConfig | None" = None, diagnostics: Diagnostics | None = None,
+                 n_lines: int = 0):
+        self.table = commands
+        self.waypoints = waypoints
+        self.file = file
+        self.flavor = flavor
+        self.machine = machine
+        self.diagnostics = diagnostics if diagnostics is not None else Diagnostics(file)
+        self.n_lines = n_lines
+        self._elapsed: np.ndarray | None = None
+
+    # -- the seed's object API ---------------------------------------------------
+
+    @property
+    def commands(self) -> Sequence[Command]:
+        """Typed commands, made when indexed."""
+        return _LazyList(len(self.table), self.table.command)
+
+    @property
+    def process_data(self) -> Sequence[ProcessData]:
+        """Process data of each command; empty before emulation."""
+        if self.waypoints is None:
+            return []
+        return _LazyList(len(self.table), self._process_data)
+
+    @property
+    def emulated(self) -> bool:
+        return self.waypoints is not None
+
+    def __len__(self) -> int:
+        return len(self.table)
+
+    def __repr__(self) -> str:
+        state = "emulated" if self.emulated else "not emulated"
+        return f"<{type(self).__name__} {self.file!r}: {len(self)} commands, {state}>"
+
+    def _waypoint_of_command(self) -> np.ndarray | None:
+        """Index of each command's own (last) waypoint, or None when one each."""
+        cmd = self.waypoints.get("command") if self.waypoints else None
+        if cmd is None:
+            return None
+        last = np.r_[cmd[1:] != cmd[:-1], True]
+        return np.flatnonzero(last)
+
+    def _process_data(self, i: int) -> ProcessData:
+        w = self.waypoints
+        mapping = self._waypoint_of_command()
+        k = i if mapping is None else int(mapping[i])
+        return self.process_data_class(**self._process_fields(k))
+
+    def _process_fields(self, k: int) -> dict[str, Any]:
+        w = self.waypoints
+        return dict(
+            location=tuple(float(w[a][k]) for a in "xyzabc"),
+            feed_rate=float(w["feed"][k]),
+            elapsed_time=float(self.elapsed_time()[k]),
+            distance=float(w["distance"][k]),
+            duration=float(w["time"][k]),
+            motion=MOTION_NAMES[int(w["motion"][k])],
+        )
+
+    def elapsed_time(self) -> np.ndarray:
+        """Time at the end of each waypoint, s (NaN steps count as zero)."""
+        if self._elapsed is None:
+            self._elapsed = np.cumsum(np.nan_to_num(self.waypoints["time"]))
+        return self._elapsed
+
+    # -- summaries ----------------------------------------------------------------
+
+    def _require_emulation(self, what: str) -> bool:
+        if self.waypoints is None:
+            warnings.warn(f"{what} needs process data: run a machine on this operation first "
+                          "(gcode_to_operation does)", stacklevel=3)
+            return False
+        return True
+
+    def get_bounds(self, which: str = "motion") -> dict[str, list[float]] | None:
+        """Axis-aligned bounds of the toolpath in machine coordinates, mm.
+
+        Parameters
+        ----------
+        which : {"motion", "feed", "extrude"}, default: "motion"
+            All moves, only feed (cutting) moves, or only extruding moves.
+            Arcs count with their full sweep, not only their end points.
+
+        Returns
+        -------
+        dict with ``min`` and ``max`` lists ``[x, y, z]``, or None (with a
+        warning) before emulation or when nothing moved.
+        """
+        if not self._require_emulation("get_bounds()"):
+            return None
+        from .bounds import toolpath_bounds
+
+        return toolpath_bounds(self.waypoints, which)
+
+    def get_statistics(self) -> dict[str, Any] | None:
+        """Counts, distances, time and (additive) layers and filament.
+
+        Returns None with a warning before emulation.
+        """
+        if not self._require_emulation("get_statistics()"):
+            return None
+        from ..analysis import operation_statistics
+
+        return operation_statistics(self)
+
+    # -- tables -------------------------------------------------------------------
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per waypoint: command columns then process columns.
+
+        Columns: ``line``, ``command`` (row in ``commands``), ``code``,
+        ``kind``, then the waypoint columns (see :data:`COLUMN_DOC`) and
+        ``elapsed_time``.  Before emulation, one row per command with only
+        the command columns and the parameters.
+        """
+        t = self.table
+        if self.waypoints is None:
+            frame = pd.DataFrame({"line": t.line, "code": self._codes(), "kind": self._kinds()})
+            for letter in sorted(t.params):
+                frame[letter] = t.param(letter)
+            return frame
+        w = self.waypoints
+        cmd = w.get("command")
+        rows = np.arange(len(t)) if cmd is None else cmd
+        data = {"line": t.line[rows], "command": rows, "code": self._codes()[rows], "kind": self._kinds()[rows]}
+        for key in FLOAT_COLUMNS:
+            data[key] = w[key]
+        for key in SMALL_COLUMNS:
+            data[key] = w[key]
+        data["motion"] = pd.Categorical.from_codes(w["motion"], categories=["none", *MOTION_NAMES[1:]])
+        data["elapsed_time"] = self.elapsed_time()
+        return pd.DataFrame(data, copy=False)
+
+    def _codes(self) -> np.ndarray:
+        t = self.table
+        letters = t.letter.astype(np.int64)
+        numbers = t.number.astype(np.int64)
+        keys = letters * 1_000_000 + np.maximum(numbers, 0)
+        uniq, inverse = np.unique(keys, return_inverse=True)
+        labels = []
+        for key in uniq.tolist():
+            letter, number = divmod(key, 1_000_000)
+            if letter in (0, ord("@")):
+                labels.append("")
+            else:
+                labels.append(chr(letter) + (str(number // 10) if number % 10 == 0 else f"{number // 10}.{number % 10}"))
+        codes = np.array(labels, dtype=object)[inverse]
+        for row, (name, _) in t.named.items():
+            codes[row] = name
+        return codes
+
+    def _kinds(self) -> pd.Categorical:
+        names = [k.name.lower() for k in Kind]
+        return pd.Categorical.from_codes(self.table.kind.astype(np.int64), categories=names)
+
+    def motions(self) -> pd.DataFrame:
+        """One row per motion, in the program's units in force at each move.
+
+        Columns ``line, motion, x, y, z, a, b, c, feed, cx, cy, cz, plane``:
+        end points and arc centres in machine coordinates (all offsets
+        applied), lengths in the units in force (mm or inch), feed in those
+        units per minute (empty for rapids), plane ``XY``/``XZ``/``YZ``.
+        """
+        if not self._require_emulation("motions()"):
+            return pd.DataFrame()
+        w = self.waypoints
+        moved = np.flatnonzero(w["motion"] > 0)
+        cmd = w.get("command")
+        rows = moved if cmd is None else cmd[moved]
+        inch = w["units"][moved] == 1
+        scale = np.where(inch, 1.0 / MM_PER_INCH, 1.0)
+        frame = {"line": self.table.line[rows],
+                 "motion": np.array(MOTION_NAMES, dtype=object)[w["motion"][moved]]}
+        for key in "xyz":
+            frame[key] = w[key][moved] * scale
+        for key in "abc":
+            frame[key] = w[key][moved]
+        feed = w["feed"][moved] * scale
+        frame["feed"] = np.where(w["motion"][moved] == 1, np.nan, feed)
+        for key in ("cx", "cy", "cz"):
+            frame[key] = w[key][moved] * scale
+        frame["plane"] = np.array(["", "XY", "XZ", "YZ"], dtype=object)[w["plane"][moved] - 16]
+        frame["units"] = np.where(inch, "in", "mm")
+        return pd.DataFrame(frame)
+
+
+class AdditiveOperation(Operation):
+    """An Operation of a deposition process (FFF, LFAM, DED)."""
+
+    process_data_class = AdditiveProcessData
+
+    @property
+    def filament_area(self) -> float:
+        d = self.machine.filament_diameter if self.machine else 1.75
+        return float(np.pi * d * d / 4.0)
+
+    def _process_fields(self, k: int) -> dict[str, Any]:
+        fields = super()._process_fields(k)
+        volume = float(self.waypoints["de"][k]) * self.filament_area
+        distance = fields["distance"]
+        fields.update(deposited_volume=volume, bead_area=volume / distance if distance > 0 and volume > 0 else 0.0,
+                      extruder_type="filament")
+        return fields
+
+
+class SubtractiveOperation(Operation):
+    """An Operation of a machining process (mill, router, lathe)."""
+
+    process_data_class = SubtractiveProcessData
+
+    def _process_fields(self, k: int) -> dict[str, Any]:
+        fields = super()._process_fields(k)
+        fields.update(spindle_speed=float(self.waypoints["spindle"][k]), removed_volume=None)
+        return fields
+
+
+OPERATION_CLASSES = {"additive": AdditiveOperation, "subtractive": SubtractiveOperation, "generic": Operation}

@@ -1,0 +1,159 @@
+"""Emulate stage: machine presets as data (``machines/<name>.toml``).
+
+A preset names the flavor a machine reads and the few facts the emulator
+needs that the program does not say: how fast rapids go, what P means in a
+dwell, what G28 does, when a tool change happens, the filament.  Unknown
+keys are errors naming the file and a did-you-mean, as for flavors.
+
+Examples
+--------
+>>> load_machine("marlin").dwell_p_unit
+'ms'
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from types import MappingProxyType
+from typing import Mapping
+
+from ..errors import ConfigError, did_you_mean
+
+MACHINE_DIR = Path(__file__).with_name("machines")
+_CHOICES = {
+    "process": ("additive", "subtractive", "generic"),
+    "dwell_p_unit": ("s", "ms"),
+    "home_mode": ("stored", "select"),
+    "tool_change_on": ("M6", "T"),
+}
+
+
+@dataclass(frozen=True)
+class MachineConfig:
+    """What a machine does where the program leaves it open.
+
+    Attributes
+    ----------
+    name, description : str
+    flavor : str
+        Flavor of the programs this machine reads.
+    process : {"additive", "subtractive", "generic"}
+        Which Operation subclass emulation produces.
+    rapid_feed : float
+        Speed of G0 moves in mm/min, used for time until the planner knows
+        the axis limits (ignored when ``rapid_is_feed``).
+    rapid_is_feed : bool or None
+        G0 moves at the modal F (printer firmware); None takes the flavor's.
+    initial_feed : float
+        Feed rate in force before the program sets one, mm/min; 0 for none
+        (a feed move before any F is then reported).
+    dwell_p_unit : {"s", "ms"}
+        Unit of P in G4 (seconds for LinuxCNC/GRBL, milliseconds for Marlin).
+    home_mode : {"stored", "select"}
+        ``stored``: G28/G30 go, through the point given by their axis words,
+        to the stored position (RS274NGC); ``select``: their axis letters
+        choose which axes home to the stored position (printer firmware).
+    tool_change_on : {"M6", "T"}
+        The word that puts the selected tool in the spindle/extruder.
+    block_delete : bool
+        The block-delete switch: lines starting with ``/`` are skipped.
+    filament_diameter : float
+        mm; turns extruded length into volume.
+    filament_density : float
+        g/cm^3; turns volume into mass.
+    work_offsets : mapping of str to list of float
+        Initial G54-G59.3 offsets in mm, e.g. ``G55 = [100, 0, 0]``.
+    """
+
+    name: str
+    description: str = ""
+    flavor: str = "rs274ngc"
+    process: str = "generic"
+    rapid_feed: float = 3000.0
+    rapid_is_feed: bool | None = None
+    initial_feed: float = 0.0
+    dwell_p_unit: str = "s"
+    home_mode: str = "stored"
+    tool_change_on: str = "M6"
+    block_delete: bool = False
+    filament_diameter: float = 1.75
+    filament_density: float = 1.24
+    work_offsets: Mapping[str, tuple[float, ...]] = field(default_factory=lambda: MappingProxyType({}))
+
+    def __hash__(self) -> int:
+        return hash(self.name)
+
+
+_TYPES = {f.name: f.type for f in fields(MachineConfig)}
+
+
+def list_machines() -> list[str]:
+    """Names of the bundled machine presets."""
+    return sorted(p.stem for p in MACHINE_DIR.glob("*.toml"))
+
+
+def load_machine(name_or_path: str | os.PathLike[str], **overrides) -> MachineConfig:
+    """Load a bundled preset by name, or a preset file by path.
+
+    Keyword arguments override the file's values (``rapid_feed=5000``).
+    """
+    path = Path(name_or_path)
+    if path.suffix != ".toml":
+        path = MACHINE_DIR / f"{name_or_path}.toml"
+        if not path.exists():
+            raise ConfigError(f"unknown machine {str(name_or_path)!r}; choose one of "
+                              f"{', '.join(list_machines())}" + did_you_mean(str(name_or_path), list_machines()))
+    config = _load(path.resolve())
+    if overrides:
+        config = _build({**_as_dict(config), **overrides}, path)
+    return config
+
+
+@functools.lru_cache(maxsize=None)
+def _load(path: Path) -> MachineConfig:
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise ConfigError(f"{path}: cannot read machine preset: {exc}") from exc
+    return _build(data, path)
+
+
+def _as_dict(config: MachineConfig) -> dict:
+    return {f.name: getattr(config, f.name) for f in fields(MachineConfig)}
+
+
+def _build(data: dict, path: Path) -> MachineConfig:
+    for key, value in data.items():
+        if key not in _TYPES:
+            raise ConfigError(f"{path}: unknown key {key!r}" + did_you_mean(key, _TYPES))
+        if key in _CHOICES and value not in _CHOICES[key]:
+            raise ConfigError(f"{path}: {key} = {value!r} is not one of {', '.join(_CHOICES[key])}")
+        if key in ("rapid_feed", "filament_diameter", "filament_density"):
+            if not isinstance(value, (int, float)) or isinstance(value, bool) or value <= 0:
+                raise ConfigError(f"{path}: {key} must be a positive number, not {value!r}")
+    offsets = {}
+    for code, vector in dict(data.get("work_offsets", {})).items():
+        if code not in _WORK_OFFSET_CODES or len(vector) > 6:
+            raise ConfigError(f"{path}: [work_offsets] {code} must be one of G54..G59.3 with up to 6 values"
+                              + did_you_mean(code, _WORK_OFFSET_CODES))
+        offsets[code] = tuple(float(v) for v in vector)
+    data = {**data, "work_offsets": MappingProxyType(offsets)}
+    if "name" not in data:
+        data["name"] = path.stem
+    return MachineConfig(**data)
+
+
+_WORK_OFFSET_CODES = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")
+
+
+def default_machine_for(flavor: str) -> str:
+    """The preset that runs a flavor when the user names no machine."""
+    for name in list_machines():
+        if _load((MACHINE_DIR / f"{name}.toml").resolve()).flavor == flavor and name != "generic":
+            return name
+    return "generic"

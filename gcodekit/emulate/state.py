@@ -1,0 +1,62 @@
+"""Emulate stage: the modal state of a machine between two commands.
+
+Positions are machine coordinates in millimetres (degrees for A, B, C), so
+the program position is ``position - work_offset - g92_offset``.  Offsets
+and stored positions are millimetres too, whatever units the program uses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+N_AXES = 6  # X Y Z A B C
+AXES = "XYZABC"
+LINEAR = np.array([True, True, True, False, False, False])
+MM_PER_INCH = 25.4
+
+
+def _zeros() -> np.ndarray:
+    return np.zeros(N_AXES)
+
+
+@dataclass
+class MachineState:
+    """Everything that carries from one command to the next."""
+
+    position: np.ndarray = field(default_factory=_zeros)
+    units: float = 1.0  # mm per program unit: 1 (G21) or 25.4 (G20)
+    incremental: bool = False  # G91
+    arc_incremental: bool = True  # G91.1 (the default) or G90.1
+    plane: int = 17
+    feed: float = np.nan  # mm/min, or 1/min in inverse-time mode
+    feed_mode: str = "per_minute"  # "inverse_time" (G93), "per_rev" (G95)
+    e_relative: bool = False  # M83
+    e_program: float = 0.0  # E coordinate as the program sees it (mm)
+    e_total: float = 0.0  # filament pushed so far (mm)
+    flow: float = 1.0  # M221, as a ratio
+    work_offset: int = 1  # 1..9 for G54..G59.3
+    work_offsets: np.ndarray = field(default_factory=lambda: np.zeros((10, N_AXES)))
+    g92: np.ndarray = field(default_factory=_zeros)
+    g92_saved: np.ndarray | None = None
+    home: np.ndarray = field(default_factory=_zeros)  # G28 stored position
+    home_secondary: np.ndarray = field(default_factory=_zeros)  # G30 stored position
+    tool: int = 0
+    selected_tool: int = 0
+    speed: float = 0.0  # S for the spindle, rpm
+    spindle: int = 0  # 1 CW, -1 CCW, 0 stopped
+    coolant: int = 0  # bit 1 mist, bit 2 flood
+    ended: bool = False  # M2/M30 reached: later blocks are not run
+
+    @property
+    def offset(self) -> np.ndarray:
+        """Total offset from program to machine coordinates."""
+        return self.work_offsets[self.work_offset] + self.g92
+
+    def program_position(self) -> np.ndarray:
+        return self.position - self.offset
+
+    def scale(self) -> np.ndarray:
+        """Program units to mm per axis (rotary axes stay in degrees)."""
+        return np.where(LINEAR, self.units, 1.0)

@@ -1,0 +1,266 @@
+"""Pipeline: compose the stages (syntax, preprocess, read, parse, emulate).
+
+No stage calls another sideways; this module chooses the flavor and the
+machine, streams the program through the stages chunk by chunk, and joins
+the chunks into one :class:`~gcodekit.emulate.operation.Operation`.
+
+Examples
+--------
+>>> import gcodekit
+>>> df = gcodekit.gcode_file_to_dataframe("G1 X10 Y0 F600\\nG2 X0 Y0 I-5 J0\\n", machine="linuxcnc")
+>>> df[["motion", "x", "distance"]].round(3).values.tolist()
+[['feed', 10.0, 10.0], ['arc_cw', 0.0, 15.708]]
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import sys
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+import pandas as pd
+
+from .emulate.machine import Machine
+from .emulate.operation import OPERATION_CLASSES, Operation
+from .emulate.presets import MachineConfig, default_machine_for, load_machine
+from .errors import Diagnostics, check_choice
+from .parse import CommandTable, GcodeParser
+from .read import Blocks, iter_blocks, iter_lines, read_source_lines
+from .syntax import Flavor, detect_flavor, load_flavor
+
+__all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate", "resolve"]
+
+_PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
+
+
+@dataclasses.dataclass
+class Program:
+    """Where a program comes from: a file path, or text given directly."""
+
+    name: str
+    path: Path | None = None
+    text: str | None = None
+
+    def chunks(self) -> Iterator[bytes]:
+        return iter_lines(self.path if self.path is not None else self.text)
+
+    def head(self, size: int = 65536) -> str:
+        if self.text is not None:
+            return self.text[:size]
+        for chunk in self.chunks():
+            return chunk[:size].decode("utf-8", "replace")
+        return ""
+
+
+def as_program(source: str | os.PathLike) -> Program:
+    """A path names a file; a string with a newline, or no such file, is program text."""
+    if isinstance(source, os.PathLike):
+        return Program(str(source), path=Path(source))
+    if not isinstance(source, str):
+        raise TypeError(f"expected a path or program text, not {type(source).__name__}")
+    if "\n" not in source and os.path.isfile(source):
+        return Program(source, path=Path(source))
+    if "\n" not in source and (os.sep in source or source.lower().endswith(_PROGRAM_SUFFIXES)):
+        raise FileNotFoundError(f"no such program file: {source!r}")
+    return Program("<string>", text=source)
+
+
+def resolve(program: Program, machine: str | MachineConfig | None, flavor: str | Flavor | None,
+            **machine_options) -> tuple[Flavor, MachineConfig, str]:
+    """Choose flavor and machine: explicit ones first, else detection.
+
+    Returns the flavor, the machine and a sentence saying how the flavor was
+    chosen.
+    """
+    config = None
+    if isinstance(machine, MachineConfig):
+        config = machine
+    elif machine is not None:
+        config = load_machine(machine)
+    if flavor is not None:
+        fl = load_flavor(flavor) if isinstance(flavor, (str, os.PathLike)) else flavor
+        how = "given"
+    elif config is not None:
+        fl, how = load_flavor(config.flavor), f"from machine {config.name}"
+    else:
+        detection = detect_flavor(program.head(), program.name if program.path else None)
+        fl, how = load_flavor(detection.name), "detected: " + "; ".join(detection.reasons)
+    if config is None:
+        config = load_machine(default_machine_for(fl.name))
+    if machine_options:
+        config = dataclasses.replace(config, **machine_options)
+    return fl, config, how
+
+
+def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None, *,
+                  mode: str = "lenient") -> Operation:
+    """Read and parse a program without emulating it (no process data yet)."""
+    program = as_program(source)
+    fl, config, _ = resolve(program, None, flavor)
+    diagnostics = Diagnostics(program.name, mode)
+    parser = GcodeParser(fl, diagnostics)
+    parts, n_lines = [], 0
+    for blocks, lines in _blocks(program, fl, diagnostics):
+        parts.append(parser.parse(blocks))
+        n_lines += lines
+    cls = OPERATION_CLASSES[config.process]
+    return cls(CommandTable.concat(parts) if parts else _empty_table(parser, program),
+               file=program.name, flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
+
+
+def emulate(operation: Operation, machine: str | MachineConfig | None = None) -> Operation:
+    """Run a parsed operation on a machine; returns the same operation, emulated."""
+    config = operation.machine if machine is None else (
+        machine if isinstance(machine, MachineConfig) else load_machine(machine))
+    fl = operation.flavor
+    m = Machine(config, operation.diagnostics, rapid_is_feed=fl.rapid_is_feed, initial_units=fl.units,
+                initial_extrusion=fl.extrusion)
+    operation.waypoints = m.run(operation.table)
+    operation.machine = config
+    return operation
+
+
+def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig | None = None, *,
+                       flavor: str | Flavor | None = None, mode: str = "lenient",
+                       progress: bool = False, **machine_options) -> Operation:
+    """Read, parse and emulate a program into an :class:`Operation`.
+
+    Parameters
+    ----------
+    source : path or str
+        A program file (plain or gzip) or the program text itself.
+    machine : str or MachineConfig, default: the preset for the flavor
+        ``"linuxcnc"``, ``"marlin"``, ``"klipper"``, ``"grbl"``, ... (see
+        :func:`gcodekit.list_machines`).
+    flavor : str or Flavor, default: the machine's, else detected
+    mode : {"lenient", "strict"}, default: "lenient"
+        Lenient records problems in ``operation.diagnostics`` and goes on;
+        strict raises the first as a :class:`~gcodekit.errors.GcodeError`.
+    progress : bool, default: False
+        Show a progress bar on standard error.
+    **machine_options
+        Override preset values (``rapid_feed=5000``).
+
+    Returns
+    -------
+    Operation, AdditiveOperation or SubtractiveOperation (by the machine's process).
+
+    Examples
+    --------
+    >>> op = gcode_to_operation("G21\\nG0 X10\\nG1 Y5 F300\\n", machine="linuxcnc")
+    >>> op.process_data[2].location[:2], op.process_data[2].duration
+    ((10.0, 5.0), 1.0)
+    """
+    check_choice("mode", mode, ("lenient", "strict"))
+    program = as_program(source)
+    fl, config, _ = resolve(program, machine, flavor, **machine_options)
+    diagnostics = Diagnostics(program.name, mode)
+    parser = GcodeParser(fl, diagnostics)
+    m = Machine(config, diagnostics, rapid_is_feed=fl.rapid_is_feed, initial_units=fl.units,
+                initial_extrusion=fl.extrusion)
+    tables, waypoints, n_lines = [], [], 0
+    bar = _progress(program, progress)
+    for blocks, lines in _blocks(program, fl, diagnostics, bar):
+        table = parser.parse(blocks)
+        tables.append(table)
+        waypoints.append(m.run(table))
+        n_lines += lines
+    if bar is not None:
+        bar.close()
+    cls = OPERATION_CLASSES[config.process]
+    table = CommandTable.concat(tables) if tables else _empty_table(parser, program)
+    if not tables:
+        waypoints.append(m.run(table))
+    op = cls(table, _concat_waypoints(waypoints, [len(t) for t in tables] or [0]), file=program.name,
+             flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
+    quote_diagnostics(op.diagnostics, program)
+    return op
+
+
+def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineConfig | None = None,
+                            **kwargs) -> pd.DataFrame:
+    """The waypoint table of a program as a DataFrame (see ``Operation.to_dataframe``)."""
+    return gcode_to_operation(source, machine, **kwargs).to_dataframe()
+
+
+# -- helpers -----------------------------------------------------------------------
+
+
+def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None) -> Iterator[tuple[Blocks, int]]:
+    """Blocks of the program chunk by chunk, preprocessed when it needs it."""
+    if flavor.parameters:
+        from .preprocess import ParameterStage, SourceLine, needs_parameters, run_stages
+
+        text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
+        if needs_parameters(text):
+            lines = text.split("\n")
+            if lines and lines[-1] == "":
+                lines.pop()
+            source = (SourceLine(t.rstrip("\r"), k + 1, program.name) for k, t in enumerate(lines))
+            out = run_stages(source, [ParameterStage(flavor)], diagnostics)
+            yield read_source_lines(out, flavor, diagnostics), len(lines)
+            return
+        chunks: Iterator[bytes] = iter_lines(text)
+    else:
+        chunks = program.chunks()
+    sizes: list[int] = []
+
+    def counted():
+        for c in chunks:
+            sizes.append(c.count(b"\n"))
+            if bar is not None:
+                bar.update(len(c))
+            yield c
+
+    for blocks in iter_blocks(counted(), flavor, diagnostics):
+        yield blocks, sizes[-1]
+
+
+def _progress(program: Program, enabled: bool):
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    total = program.path.stat().st_size if program.path is not None and program.path.suffix != ".gz" else None
+    return tqdm(total=total, unit="B", unit_scale=True, desc=Path(program.name).name, file=sys.stderr,
+                leave=False)
+
+
+def _empty_table(parser: GcodeParser, program: Program) -> CommandTable:
+    return parser.parse(Blocks.empty(program.name))
+
+
+def _concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarray]:
+    """Join per-chunk waypoint columns, one column at a time to bound memory."""
+    if len(parts) == 1:
+        return parts[0]
+    if any("command" in p for p in parts):
+        shift = np.cumsum([0] + sizes[:-1])
+        for p, s, n in zip(parts, shift, sizes):
+            p["command"] = p.get("command", np.arange(n)) + s
+    out = {}
+    for key in list(parts[0]):
+        out[key] = np.concatenate([p.pop(key) for p in parts])
+    return out
+
+
+def quote_diagnostics(diagnostics: Diagnostics, program: Program, limit: int = 1000) -> None:
+    """Fill in the source text of diagnostics that were made without it."""
+    wanted = {d.line for d in diagnostics.items[:limit] if not d.text}
+    if not wanted:
+        return
+    found: dict[int, str] = {}
+    line_no = 0
+    for chunk in program.chunks():
+        for raw in chunk.split(b"\n")[:-1]:
+            line_no += 1
+            if line_no in wanted:
+                found[line_no] = raw[:200].decode("utf-8", "replace").rstrip("\r")
+        if len(found) == len(wanted):
+            break
+    diagnostics.items = [
+        dataclasses.replace(d, text=found.get(d.line, "")) if not d.text else d for d in diagnostics.items
+    ]
