@@ -171,10 +171,11 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     if bar is not None:
         bar.close()
     cls = OPERATION_CLASSES[config.process]
+    sizes = [len(t) for t in tables]
     table = CommandTable.concat(tables) if tables else _empty_table(parser, program)
     if not tables:
-        waypoints.append(m.run(table))
-    op = cls(table, _concat_waypoints(waypoints, [len(t) for t in tables] or [0]), file=program.name,
+        waypoints, sizes = [m.run(table)], [0]
+    op = cls(table, _concat_waypoints(waypoints, sizes), file=program.name,
              flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
     quote_diagnostics(op.diagnostics, program)
     return op

@@ -8,6 +8,7 @@ belongs to its value, and errors for every undefined result.
 import math
 import re
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -58,6 +59,9 @@ from gcodekit.preprocess import expressions
         ("EXP[0]", 1.0), ("EXP[1]", math.e), ("LN[1]", 0.0), ("LN[EXP[2]]", 2.0),
         ("SQRT[16]", 4.0), ("SQRT[0]", 0.0),
         ("FIX[2.5]", 2.0), ("FIX[-2.5]", -3.0), ("FUP[2.5]", 3.0), ("FUP[-2.5]", -2.0),
+        # a zero keeps its sign, as in C, and ATAN tells them apart
+        ("ATAN[0]/[FUP[-0.5]]", 180.0), ("ATAN[0]/[-3 MOD 1]", 180.0), ("ATAN[0]/[ABS[-0]]", 180.0),
+        ("ATAN[0]/[FIX[0.5]]", 0.0),
         ("ROUND[2.5]", 3.0), ("ROUND[-2.5]", -3.0), ("ROUND[2.4999]", 2.0), ("ROUND[-0.4]", 0.0),
         ("ATAN[1]/[1]", 45.0), ("ATAN[1]/[-1]", 135.0), ("ATAN[-1]/[-1]", -135.0),
         ("ATAN[0]/[-1]", 180.0), ("ATAN[1]/[0]", 90.0),
@@ -296,15 +300,21 @@ def unary(name, x):
         raise Undefined
     try:
         return {
-            "ABS": lambda: abs(x), "ACOS": lambda: math.acos(x) * 180.0 / math.pi,
+            "ABS": lambda: x if x >= 0 else -x, "ACOS": lambda: math.acos(x) * 180.0 / math.pi,
             "ASIN": lambda: math.asin(x) * 180.0 / math.pi, "COS": lambda: math.cos(rad),
-            "EXP": lambda: math.exp(x), "FIX": lambda: float(math.floor(x)),
-            "FUP": lambda: float(math.ceil(x)), "LN": lambda: math.log(x),
+            "EXP": lambda: math.exp(x), "FIX": lambda: float(np.floor(x)),
+            "FUP": lambda: float(np.ceil(x)), "LN": lambda: math.log(x),
             "ROUND": lambda: float(math.floor(x + 0.5) if x >= 0 else math.ceil(x - 0.5)),
             "SIN": lambda: math.sin(rad), "SQRT": lambda: math.sqrt(x), "TAN": lambda: math.tan(rad),
         }[name]()
     except OverflowError:
         raise Undefined from None
+
+
+def modulo(a, b):
+    """LinuxCNC: C fmod (a zero result keeps a's sign), then made non-negative."""
+    r = float(np.fmod(a, b))
+    return r + abs(b) if r < 0 else r
 
 
 def binary(op, a, b):
@@ -315,7 +325,7 @@ def binary(op, a, b):
     try:
         result = {
             "**": lambda: a ** b, "*": lambda: a * b, "/": lambda: a / b,
-            "MOD": lambda: a % abs(b), "+": lambda: a + b, "-": lambda: a - b,
+            "MOD": lambda: modulo(a, b), "+": lambda: a + b, "-": lambda: a - b,
         }[op]()
     except KeyError:
         pass

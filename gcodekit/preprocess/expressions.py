@@ -531,10 +531,12 @@ def _function(name: str, args: list[float], col: int) -> float:
     if name == "round":
         # LinuxCNC: (int)(x + 0.5) for x >= 0, (int)(x - 0.5) below: half away from zero.
         return float(math.trunc(x + 0.5 if x >= 0.0 else x - 0.5))
+    # C's floor, ceil and LinuxCNC's ABS keep the sign of a zero (FUP[-0.5]
+    # is -0.0), which ATAN can tell apart; Python's versions do not.
     simple = {
-        "abs": abs,
-        "fix": math.floor,
-        "fup": math.ceil,
+        "abs": lambda v: -v if v < 0.0 else v,
+        "fix": lambda v: math.copysign(math.floor(v), v),
+        "fup": lambda v: math.copysign(math.ceil(v), v),
         "sin": lambda v: math.sin(v * math.pi / 180.0),
         "cos": lambda v: math.cos(v * math.pi / 180.0),
         "tan": lambda v: math.tan(v * math.pi / 180.0),

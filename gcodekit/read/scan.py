@@ -1,14 +1,16 @@
 """Read stage, fast path: bytes of many lines to words with NumPy, no Python per line.
 
-A line is *regular* when, outside its ``;`` comment, it holds only letters
-each followed by a plain decimal number (``G1 X10.5 Y-3 E.02``).  Those lines
-are cut and their numbers converted here in bulk; every other line (paren
-comments, parameters, checksums, named commands, anything odd) is returned as
-*irregular* for :class:`~.tokenize.LineTokenizer`, which knows every rule.
+A line is *regular* when, outside its line comment, it holds only letters
+each followed by a plain decimal number (``G1 X10.5 Y-3 E.02``).  Those
+lines are cut and their numbers converted here in bulk; every other line
+(paren comments, parameters, checksums, named commands, anything odd) is
+returned as *irregular* for :class:`~.tokenize.LineTokenizer`, which knows
+every rule.
 
-Numbers are converted exactly: the digits form an integer mantissa below
-2**53 and the value is ``mantissa / 10**n_fraction_digits``, one correctly
-rounded IEEE division, so the result equals Python's ``float(text)``.
+Numbers are converted exactly: the digits of a word form an integer below
+2**53, summed exactly in float64, and the value is that integer divided by
+``10**n_fraction_digits`` -- one correctly rounded IEEE division, so the
+result equals Python's ``float(text)``.
 """
 
 from __future__ import annotations
@@ -19,9 +21,26 @@ import numpy as np
 
 from ..syntax import Flavor
 
-_MAX_DIGITS = 15  # below 2**53, so the mantissa is exact in float64
-_POW10_INT = 10 ** np.arange(19, dtype=np.int64)
-_POW10_FLOAT = 10.0 ** np.arange(23)
+_MAX_DIGITS = 15  # keeps the integer below 2**53, exact in float64
+_POW10 = 10.0 ** np.arange(23)
+
+# Byte classes.
+_OTHER, _UPPER, _LOWER, _DIGIT, _DOT, _SIGN, _BLANK, _NEWLINE, _COMMENT = range(9)
+
+
+def _byte_classes(flavor: Flavor) -> np.ndarray:
+    table = np.full(256, _OTHER, np.uint8)
+    table[ord("A") : ord("Z") + 1] = _UPPER
+    table[ord("a") : ord("z") + 1] = _LOWER
+    table[ord("0") : ord("9") + 1] = _DIGIT
+    table[ord(".")] = _DOT
+    table[[ord("+"), ord("-")]] = _SIGN
+    table[[ord(" "), ord("\t"), ord("\r")]] = _BLANK
+    table[ord("\n")] = _NEWLINE
+    for c in flavor.line_comments:
+        if len(c) == 1 and ord(c) < 128:
+            table[ord(c)] = _COMMENT
+    return table
 
 
 @dataclass
@@ -52,123 +71,121 @@ def fast_path_possible(flavor: Flavor) -> bool:
 def scan(data: bytes, flavor: Flavor) -> ScanResult:
     """Cut ``data`` (whole lines, ending with ``\\n``) into words and comments."""
     b = np.frombuffer(data, dtype=np.uint8)
-    nl = np.flatnonzero(b == 10)
+    cls = _byte_classes(flavor)[b]
+    nl = np.flatnonzero(cls == _NEWLINE)
     n_lines = nl.size
-    line_start = np.empty(n_lines, dtype=np.int64)
-    if n_lines:
-        line_start[0] = 0
-        line_start[1:] = nl[:-1] + 1
-    line_id = np.zeros(b.size, dtype=np.int32)
-    line_id[line_start[1:]] = 1
-    np.cumsum(line_id, out=line_id)
+    line_start = np.r_[0, nl[:-1] + 1] if n_lines else np.zeros(0, np.int64)
 
-    comment_first, comment_line = _first_comment_chars(b, line_id, flavor)
-    in_comment = np.zeros(b.size + 1, dtype=np.int8)
-    np.add.at(in_comment, comment_first, 1)
-    np.add.at(in_comment, nl[comment_line], -1)
-    in_comment = np.cumsum(in_comment[:-1], dtype=np.int8).view(bool)
+    # Line comments run from the first comment character to the end of the line.
+    marks = np.flatnonzero(cls == _COMMENT)
+    mark_line = np.searchsorted(nl, marks)
+    first = np.r_[True, mark_line[1:] != mark_line[:-1]] if marks.size else np.zeros(0, bool)
+    c_start, c_line = marks[first], mark_line[first]
+    c_end = nl[c_line]
+    keep = cls != _BLANK
+    keep[_ranges(c_start, c_end)] = False
 
-    blank = (b == 32) | (b == 9) | (b == 13)
-    keep = ~(in_comment | blank)
     pos = np.flatnonzero(keep)
-    cb = b[pos]
-    cline = line_id[pos]
-    del keep, in_comment
+    del keep
+    c = cls[pos]
+    ob = b[pos]
+    is_nl = c == _NEWLINE
+    is_letter = (c == _UPPER) if flavor.case_sensitive else ((c == _UPPER) | (c == _LOWER))
+    is_num = (c >= _DIGIT) & (c <= _SIGN)
+    cline = np.cumsum(is_nl, dtype=np.int32)
+    cline -= is_nl  # a newline belongs to the line it ends
 
-    if not flavor.case_sensitive:
-        lower = (cb >= 97) & (cb <= 122)
-        cb = cb - (lower.view(np.uint8) << 5)
-    is_letter = (cb >= 65) & (cb <= 90)
-    is_digit = (cb >= 48) & (cb <= 57)
-    is_dot = cb == 46
-    is_sign = (cb == 43) | (cb == 45)
-    is_nl = cb == 10
-    is_num = is_digit | is_dot | is_sign
-
-    bad = ~(is_letter | is_num | is_nl)
     prev_letter = np.r_[False, is_letter[:-1]]
     prev_num = np.r_[False, is_num[:-1]]
-    next_num = np.r_[is_num[1:], False]
+    bad = ~(is_letter | is_num | is_nl)  # other bytes, or lower case where that is not a word
     bad |= is_num & ~(prev_letter | prev_num)  # a number with no letter before it
-    bad |= is_letter & ~next_num  # a letter with no number (flag, named command)
-    bad |= is_sign & ~prev_letter  # a sign inside a number
-    if not flavor.spaces_in_numbers:
-        gap = np.r_[False, np.diff(pos) > 1]
-        bad |= is_num & prev_num & gap  # "X1 0": blank inside a number
+    bad |= is_letter & ~np.r_[is_num[1:], False]  # a letter without a number (flag, name)
+    bad |= (c == _SIGN) & ~prev_letter  # a sign inside a number
     line_ok = np.ones(n_lines, dtype=bool)
     line_ok[cline[bad]] = False
-    del bad, prev_letter, prev_num, next_num
+    del bad, prev_letter, prev_num
 
-    take = line_ok[cline] & ~is_nl
-    ob = cb[take]
-    opos = pos[take]
-    oline = cline[take]
-    o_letter = is_letter[take]
-    o_digit = is_digit[take]
-    o_dot = is_dot[take]
-    del take, cb, pos, cline, is_letter, is_digit, is_dot, is_sign, is_nl, is_num
-
-    starts = np.flatnonzero(o_letter)
-    ends = np.r_[starts[1:], ob.size] - 1
-    digits_upto = np.cumsum(o_digit, dtype=np.int32)
-    n_digits = digits_upto[ends] - digits_upto[starts]
-    n_dots = np.add.reduceat(o_dot.view(np.uint8), starts, dtype=np.int32) if starts.size else starts
+    # Segments start at each letter and each newline, so no word runs into
+    # the next line; the segments that start with a letter are the words.
+    head = is_letter | is_nl
+    heads = np.flatnonzero(head)
+    segment = np.cumsum(head, dtype=np.int32)
+    segment -= 1
+    n_seg = heads.size
+    seg_end = np.r_[heads[1:], c.size] - 1
+    is_digit = c == _DIGIT
+    digits_upto = np.cumsum(is_digit, dtype=np.int32)
+    nums_upto = np.cumsum(is_num, dtype=np.int32)
+    digit_end = digits_upto[seg_end]  # digits up to the end of each segment
+    words = np.flatnonzero(is_letter[heads])
+    starts = heads[words]
+    token_line = cline[starts]
+    n_digits = digit_end[words] - digits_upto[starts]
+    n_chars = nums_upto[seg_end[words]] - nums_upto[starts]
+    dots = np.flatnonzero(c == _DOT)
+    dot_seg = segment[dots]
+    dots, dot_seg = dots[dot_seg >= 0], dot_seg[dot_seg >= 0]
+    n_dots = np.bincount(dot_seg, minlength=n_seg)[words]
     token_bad = (n_digits == 0) | (n_digits > _MAX_DIGITS) | (n_dots > 1)
-    if token_bad.any():
-        line_ok[oline[starts[token_bad]]] = False
+    if not flavor.spaces_in_numbers:
+        # Blanks are allowed between the letter and its number, not inside it.
+        last = np.minimum(starts + n_chars, c.size - 1)
+        after_letter = pos[np.minimum(starts + 1, c.size - 1)] - pos[starts] - 1
+        token_bad |= (pos[last] - pos[starts] - n_chars) != after_letter
+    line_ok[token_line[token_bad]] = False
 
-    token = np.cumsum(o_letter, dtype=np.int32) - 1
-    after = digits_upto[ends][token] - digits_upto
-    np.clip(after, 0, 18, out=after)
-    contrib = np.where(o_digit, (ob - 48).astype(np.int64) * _POW10_INT[after], 0)
-    mantissa = np.add.reduceat(contrib, starts) if starts.size else np.zeros(0, np.int64)
-    del contrib, after
-    n_frac = np.zeros(starts.size, dtype=np.int32)
-    dots = np.flatnonzero(o_dot)
-    n_frac[token[dots]] = digits_upto[ends][token[dots]] - digits_upto[dots]
-    value = mantissa / _POW10_FLOAT[np.minimum(n_frac, 22)]
-    negative = ob[np.minimum(starts + 1, ob.size - 1)] == 45
-    value[negative] = -value[negative]
+    # Value of each word: sum of digit * 10**(digits after it in the word).
+    digit_at = np.flatnonzero(is_digit)
+    after = digit_end[segment[digit_at]] - np.arange(1, digit_at.size + 1, dtype=np.int32)
+    np.clip(after, 0, 22, out=after)
+    contrib = (ob[digit_at] - 48) * _POW10[after]
+    if heads.size:
+        # One trailing zero keeps every segment's first-digit index in range.
+        contrib = np.append(contrib, 0.0)
+        mantissa = np.add.reduceat(contrib, digits_upto[heads])[words]
+        mantissa[n_digits == 0] = 0.0
+    else:
+        mantissa = np.zeros(0)
+    frac_seg = np.zeros(n_seg, dtype=np.int32)
+    frac_seg[dot_seg] = digit_end[dot_seg] - digits_upto[dots]
+    value = mantissa / _POW10[np.clip(frac_seg[words], 0, 22)]
+    value[ob[np.minimum(starts + 1, ob.size - 1)] == ord("-")] *= -1.0
 
-    keep_tok = line_ok[oline[starts]]
-    word_line = oline[starts][keep_tok]
-    word_col = (opos[starts][keep_tok] - line_start[word_line] + 1).astype(np.int32)
-    comment_keep = line_ok[comment_line]
-    first = comment_first[comment_keep]
-    cline_kept = comment_line[comment_keep]
-    data_mask = np.zeros(b.size + 1, dtype=np.int8)
-    np.add.at(data_mask, first + 1, 1)
-    np.add.at(data_mask, nl[cline_kept], -1)
-    data_mask = np.cumsum(data_mask[:-1], dtype=np.int8).view(bool)
-    lengths = nl[cline_kept] - first - 1
+    keep_tok = line_ok[token_line]
+    word_line = token_line[keep_tok]
+    word_pos = pos[starts[keep_tok]]
+    letters = ob[starts[keep_tok]]
+    if not flavor.case_sensitive:
+        letters = letters & 0xDF
+
+    comment_keep = line_ok[c_line]
+    c_start, c_line, c_end = c_start[comment_keep], c_line[comment_keep], c_end[comment_keep]
+    lengths = c_end - c_start - 1
     offsets = np.zeros(lengths.size + 1, dtype=np.int64)
     np.cumsum(lengths, out=offsets[1:])
     return ScanResult(
         word_line=word_line,
-        word_letter=ob[starts][keep_tok],
+        word_letter=letters,
         word_value=value[keep_tok],
-        word_col=word_col,
-        comment_line=cline_kept.astype(np.int32),
-        comment_col=(first - line_start[cline_kept] + 1).astype(np.int32),
+        word_col=(word_pos - line_start[word_line] + 1).astype(np.int32),
+        comment_line=c_line.astype(np.int32),
+        comment_col=(c_start - line_start[c_line] + 1).astype(np.int32),
         comment_offsets=offsets,
-        comment_data=b[data_mask].tobytes(),
+        comment_data=b[_ranges(c_start + 1, c_end)].tobytes(),
         irregular=np.flatnonzero(~line_ok).astype(np.int32),
         line_start=line_start,
         n_lines=n_lines,
     )
 
 
-def _first_comment_chars(b: np.ndarray, line_id: np.ndarray, flavor: Flavor):
-    """Position of the first line-comment character of each commented line.
-
-    A ``(`` left before it is not a word character, so a line with a paren
-    comment becomes irregular and the reference tokenizer, which knows how
-    ``(`` and ``;`` interact, reads it.
-    """
-    marks = [np.flatnonzero(b == ord(c)) for c in flavor.line_comments if len(c) == 1 and ord(c) < 128]
-    if not marks:
-        return np.zeros(0, np.int64), np.zeros(0, np.int32)
-    found = np.sort(np.concatenate(marks)) if len(marks) > 1 else marks[0]
-    lines = line_id[found]
-    firsts = np.r_[True, lines[1:] != lines[:-1]] if found.size else np.zeros(0, bool)
-    return found[firsts], lines[firsts]
+def _ranges(starts: np.ndarray, stops: np.ndarray) -> np.ndarray:
+    """Concatenated ``arange(start, stop)`` for each pair, without a Python loop."""
+    nonempty = stops > starts
+    starts, lengths = starts[nonempty], (stops - starts)[nonempty]
+    if not starts.size:
+        return np.zeros(0, np.int64)
+    out = np.ones(int(lengths.sum()), dtype=np.int64)
+    out[0] = starts[0]
+    # At each range's head, jump from the previous range's last value to its start.
+    out[np.cumsum(lengths)[:-1]] = starts[1:] - (starts[:-1] + lengths[:-1] - 1)
+    return np.cumsum(out)

@@ -1,0 +1,127 @@
+"""Read stage: the vectorized scanner must agree with the reference tokenizer."""
+
+from __future__ import annotations
+
+import gzip
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gcodekit.errors import Diagnostics, GcodeError
+from gcodekit.read import Blocks, read_file, read_text
+from gcodekit.read.tokenize import LineTokenizer
+from gcodekit.syntax import load_flavor
+
+
+def reference_blocks(text: str, flavor_name: str) -> tuple[Blocks, Diagnostics]:
+    """Every line through the per-line tokenizer only."""
+    flavor = load_flavor(flavor_name)
+    diagnostics = Diagnostics()
+    tokenizer = LineTokenizer(flavor, diagnostics)
+    raw = []
+    for number, line in enumerate(text.split("\n")[: text.count("\n") + (0 if text.endswith("\n") else 1)], 1):
+        raw.extend(tokenizer.tokenize(line.rstrip("\r"), number))
+    return Blocks.from_raw("<string>", raw), diagnostics
+
+
+def by_line(blocks: Blocks) -> dict[int, tuple]:
+    """Words and comments keyed by source line, ignoring empty blocks."""
+    out = {}
+    for i in range(len(blocks)):
+        b = blocks[i]
+        if b.words or b.comments or b.flags or b.named:
+            out[b.line] = (tuple((w.letter, w.value, w.column) for w in b.words), b.comments, b.flags, b.named)
+    return out
+
+
+number = st.builds(
+    lambda sign, whole, frac: sign + whole + frac,
+    st.sampled_from(["", "-", "+"]),
+    st.text("0123456789", max_size=6),
+    st.one_of(st.just(""), st.text("0123456789", max_size=6).map(lambda d: "." + d)),
+)
+word = st.builds(lambda l, blank, n: l + blank + n, st.sampled_from("GMXYZEFIJKSTPgxy"),
+                 st.sampled_from(["", "", " "]), number)
+junk = st.sampled_from(["(note)", "\"s\"", "#1", "*12", "=", "[1]", "é", "\t", "  ", "/", "%", "@"])
+line = st.lists(st.one_of(word, word, word, junk), max_size=6).map(" ".join)
+comment = st.one_of(st.just(""), st.text(max_size=10).filter(lambda t: "\n" not in t and "\r" not in t).map(lambda t: " ;" + t))
+program = st.lists(st.builds(lambda l, c: l + c, line, comment), max_size=12).map(lambda ls: "\n".join(ls) + "\n")
+
+
+@settings(max_examples=300, deadline=None)
+@given(program, st.sampled_from(["marlin", "rs274ngc", "klipper", "grbl"]))
+def test_fast_scanner_matches_reference_tokenizer(text, flavor):
+    fast = read_text(text, flavor=flavor)
+    ref, ref_diag = reference_blocks(text, flavor)
+    assert by_line(fast) == by_line(ref)
+    assert [str(d) for d in fast.diagnostics] == [str(d) for d in ref_diag]
+
+
+def test_numbers_convert_exactly_like_python_float():
+    rng = np.random.default_rng(7)
+    values = [f"{v:.{d}f}" for v, d in zip(rng.normal(0, 1000, 2000), rng.integers(0, 9, 2000))]
+    text = "".join(f"G1 X{v}\n" for v in values)
+    blocks = read_text(text, flavor="marlin")
+    xs = blocks.word_value[blocks.word_letter == ord("X")]
+    assert xs.tolist() == [float(v) for v in values]
+
+
+def test_comment_text_and_columns():
+    blocks = read_text("G1 X1 ; first\n;TYPE:Perimeter\n  G0 Y-2.5\n", flavor="marlin")
+    assert blocks[0].comments == ("first",)
+    assert blocks[1].comments == ("TYPE:Perimeter",)
+    assert blocks[2].words[1].column == 6
+    assert blocks[2].words[1].value == -2.5
+
+
+def test_paren_comments_and_block_delete_rs274():
+    blocks = read_text("/G1 X1 (move) Y2\n(only a comment)\n", flavor="rs274ngc")
+    assert [w.letter for w in blocks[0].words] == ["G", "X", "Y"]
+    assert blocks[0].comments == ("move",)
+    assert blocks[0].deleted
+    assert blocks[1].comments == ("only a comment",)
+
+
+def test_spaces_inside_numbers_only_where_the_flavor_allows():
+    assert read_text("G1 X1 0\n", flavor="rs274ngc")[0].words[1].value == 10.0
+    lenient = read_text("G1 X1 0\n", flavor="marlin")
+    assert lenient[0].words[1].value == 1.0
+    assert lenient.diagnostics.items[0].line == 1 and lenient.diagnostics.items[0].column == 7
+
+
+def test_klipper_extended_commands_are_named():
+    blocks = read_text("SET_VELOCITY_LIMIT ACCEL=500 ; why\nG1 X1\n", flavor="klipper")
+    assert blocks[0].named == ("SET_VELOCITY_LIMIT", "ACCEL=500")
+    assert blocks[0].comments == ("why",)
+
+
+def test_gzip_and_plain_files_read_the_same(tmp_path):
+    text = "G1 X1 Y2\nG1 X3 ; c\n" * 100
+    (tmp_path / "a.gcode").write_text(text)
+    with gzip.open(tmp_path / "a.gcode.gz", "wt") as f:
+        f.write(text)
+    plain = read_file(tmp_path / "a.gcode", flavor="marlin")
+    packed = read_file(tmp_path / "a.gcode.gz", flavor="marlin")
+    assert by_line(plain) == by_line(packed)
+    assert len(plain) == 200
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.binary(max_size=400), st.sampled_from(["marlin", "rs274ngc", "ger", "beckhoff_ded", "fanuc"]))
+def test_random_bytes_never_crash_the_reader(data, flavor):
+    text = data.decode("latin-1")
+    read_text(text, flavor=flavor)  # lenient: never raises
+    try:
+        read_text(text, flavor=flavor, mode="strict")
+    except GcodeError:
+        pass
+
+
+def test_strict_mode_raises_with_location():
+    with pytest.raises(GcodeError) as info:
+        read_text("G1 X1\nG1 X$2\n", flavor="marlin", mode="strict")
+    d = info.value.diagnostic
+    assert (d.line, d.column) == (2, 5)
+    assert "<string>:2:5" in str(info.value)
