@@ -244,7 +244,13 @@ def _concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarr
             p["command"] = p.get("command", np.arange(n)) + s
     out = {}
     for key in list(parts[0]):
-        out[key] = np.concatenate([p.pop(key) for p in parts])
+        cols = [p.pop(key) for p in parts]
+        first = cols[0][0] if cols[0].size else None
+        if key != "command" and all(c.strides == (0,) for c in cols) and all(
+                (c[0] == first) or (c[0] != c[0] and first != first) for c in cols if c.size):
+            out[key] = np.broadcast_to(first, (sum(c.size for c in cols),))
+        else:
+            out[key] = np.concatenate(cols)
     return out
 
 

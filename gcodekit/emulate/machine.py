@@ -104,7 +104,7 @@ class Machine:
         if cursor < n:
             self._hold(cursor, n, out)
             self._once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
-        return _with_extra_waypoints(out, extra, n)
+        return _constants_as_views(_with_extra_waypoints(out, extra, n))
 
     def _hold(self, start: int, stop: int, out: dict) -> None:
         """Rows after the program end: nothing moves."""
@@ -319,6 +319,17 @@ def _forward_fill(values: np.ndarray, initial: float) -> np.ndarray:
     idx = np.where(np.isnan(values), -1, np.arange(values.size))
     np.maximum.accumulate(idx, out=idx)
     return np.where(idx >= 0, values[np.maximum(idx, 0)], initial)
+
+
+def _constants_as_views(out: dict) -> dict:
+    """Columns holding one value everywhere become zero-stride views (no memory)."""
+    for key, col in out.items():
+        if key != "command" and col.size and col.strides != (0,):
+            first = col[0]
+            same = np.isnan(col).all() if col.dtype.kind == "f" and first != first else (col == first).all()
+            if same:
+                out[key] = np.broadcast_to(first, col.shape)
+    return out
 
 
 def _with_extra_waypoints(out: dict, extra: list, n: int) -> dict:

@@ -87,6 +87,7 @@ class GcodeParser:
         comment_rows = first_row[blocks.comment_block]
         parts = rows["parts_by_row"]
         named = {i: p.named for i, p in parts.items() if p.named is not None}
+        texts = {i: p.text for i, p in parts.items() if p.text}
         deleted = [first_row[b] for b, x in blocks.extras.items() if x.deleted and first_row[b] >= 0]
         return CommandTable(
             line=rows["line"].astype(np.int32),
@@ -100,8 +101,9 @@ class GcodeParser:
             comment_offsets=blocks.comment_offsets,
             comment_data=blocks.comment_data,
             named=named,
+            texts=texts,
             deleted=np.array(sorted(deleted), np.int64),
-        )
+        ).compact()
 
     # -- bulk path ------------------------------------------------------------
 
@@ -200,6 +202,8 @@ class GcodeParser:
                 parts[0].params["value"] = extra.code_value
             if not parts:
                 parts = [Part("")]
+            if extra is not None and extra.text:
+                parts[0].text = extra.text
             for sub, part in enumerate(parts):
                 rows.append((b, sub, part))
         n = len(rows)
@@ -265,10 +269,11 @@ class GcodeParser:
             return out
 
         has_axes, has_e, has_s, has_f = has("XYZABCUVW"), has("E"), has("S"), has("F")
+        arc = (motion == 3) | (motion == 4)
+        has_axes |= arc & has("IJKR")  # "G2 I5" is a full circle from where the tool is
         is_motion_name = np.isin(name, [NAME_ID[m] for m in MOTION_OF_NAME])
         implicit = (letter == 0) & has_axes if self._modal else np.zeros(n, bool)
         moving = (is_motion_name | implicit) & (has_axes | has_e)
-        arc = (motion == 3) | (motion == 4)
 
         kind = np.full(n, Kind.CONFIG, np.uint8)
         kind[letter == _G] = Kind.G

@@ -63,6 +63,7 @@ class Part:
     params: dict[str, float] = field(default_factory=dict)
     motion: str = ""  # for G53: the motion code of the block, if any
     named: tuple[str, str] | None = None  # (name, argument text) of a named command
+    text: str = ""  # string arguments (M117 message, P"MK3S")
 
 
 def code_name(flavor: Flavor, letter: str, number: float) -> str:

@@ -71,6 +71,8 @@ class CommandTable:
     comment_data : bytes
     named : dict of int to tuple
         Named commands by row: ``(name, argument text)``.
+    texts : dict of int to str
+        String arguments of ordinary commands by row (``M117 Hello``).
     deleted : ndarray of int64
         Rows from block-delete (``/``) lines, skipped when the machine's
         block-delete switch is on.
@@ -87,6 +89,7 @@ class CommandTable:
     comment_offsets: np.ndarray
     comment_data: bytes
     named: dict[int, tuple[str, str]] = field(default_factory=dict)
+    texts: dict[int, str] = field(default_factory=dict)
     deleted: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     def __len__(self) -> int:
@@ -137,7 +140,7 @@ class CommandTable:
             line=int(self.line[i]),
             comment=self.comment_of(i),
             name=NAMES[int(self.name[i])],
-            text=named[1] if named else "",
+            text=named[1] if named else self.texts.get(i, ""),
         )
 
     def compact(self) -> "CommandTable":
@@ -162,16 +165,17 @@ class CommandTable:
         params: dict[str, np.ndarray | SparseColumn] = {}
         n = sum(sizes)
         for letter in letters:
-            pieces = []
-            for p, s in zip(parts, sizes):
-                col = p.params.get(letter)
-                pieces.append(np.full(s, np.nan) if col is None else
-                              (col.dense() if isinstance(col, SparseColumn) else col))
-            dense = np.concatenate(pieces)
-            for p in parts:
-                p.params.pop(letter, None)
-            params[letter] = dense
+            cols = [p.params.pop(letter, None) for p in parts]
+            if all(c is None or isinstance(c, SparseColumn) for c in cols):
+                params[letter] = SparseColumn(
+                    np.concatenate([c.rows + s for c, s in zip(cols, shift) if c is not None]),
+                    np.concatenate([c.values for c in cols if c is not None]), n)
+            else:
+                params[letter] = np.concatenate([
+                    np.full(size, np.nan) if c is None else (c.dense() if isinstance(c, SparseColumn) else c)
+                    for c, size in zip(cols, sizes)])
         named = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.named.items()}
+        texts = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.texts.items()}
         table = cls(
             line=_cat(parts, "line"),
             kind=_cat(parts, "kind"),
@@ -184,6 +188,7 @@ class CommandTable:
             comment_offsets=_concat_offsets([p.comment_offsets for p in parts]),
             comment_data=b"".join(p.comment_data for p in parts),
             named=named,
+            texts=texts,
             deleted=np.concatenate([p.deleted + s for p, s in zip(parts, shift)]),
         )
         assert len(table) == n

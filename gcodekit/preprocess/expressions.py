@@ -17,6 +17,11 @@ LinuxCNC 2.9's ``interp_read.cc`` and ``interp_execute.cc``:
 * Angles are in degrees.  Comparisons and logic give 1.0 or 0.0; ``EQ``,
   ``NE``, ``GE`` and ``LE`` treat numbers within 0.0001 as equal.
 
+The parser reads the folded characters directly rather than a token list:
+LinuxCNC's reader is character driven (a sign followed by a digit is part of
+a number, a run of letters splits into keywords) and the parameter stage
+must stop reading right after the value of a word.
+
 Errors are :class:`~gcodekit.errors.GcodeExpressionError` (or
 :class:`~gcodekit.errors.GcodeLimitError` for :data:`MAX_DEPTH` and
 :data:`MAX_LENGTH`) whose ``diagnostic.column`` is the 1-based column of the
@@ -60,8 +65,10 @@ PRECEDENCE = {
 FUNCTIONS = ("abs", "acos", "asin", "cos", "exp", "fix", "fup", "ln", "round", "sin", "sqrt", "tan")
 #: Every word the lexer knows.  None is a prefix of another, so a run of
 #: letters such as ``andsin`` splits unambiguously, as LinuxCNC reads it.
-KEYWORDS = tuple(k for k in PRECEDENCE if k.isalpha()) + FUNCTIONS + ("atan", "exists")
+_ALL_FUNCTIONS = FUNCTIONS + ("atan", "exists")
+KEYWORDS = tuple(k for k in PRECEDENCE if k.isalpha()) + _ALL_FUNCTIONS
 _WHITESPACE = frozenset(" \t\r\n\v\f")
+_ASCII_LOWER = str.maketrans("ABCDEFGHIJKLMNOPQRSTUVWXYZ", "abcdefghijklmnopqrstuvwxyz")
 _NUMBER = re.compile(r"[0-9.]+")
 _VALID_NUMBER = re.compile(r"[0-9]+\.?[0-9]*|\.[0-9]+")
 _LETTERS = re.compile(r"[a-z]+")
@@ -171,9 +178,6 @@ def compact(text: str, start: int = 0, end: int | None = None) -> CompactText:
     # change the length of non-ASCII text.
     chars = "".join(text[i] for i in kept).translate(_ASCII_LOWER)
     return CompactText(chars, tuple(kept), end)
-
-
-_ASCII_LOWER = str.maketrans("ABCDEFGHIJKLMNOPQRSTUVWXYZ", "abcdefghijklmnopqrstuvwxyz")
 
 
 def expression_error(
@@ -301,9 +305,10 @@ class _Parser:
         # A function name is always followed by '[', so the whole run of
         # letters is the name.
         word = _LETTERS.match(s, pos).group()
-        if word not in FUNCTIONS + ("atan", "exists"):
-            names = [f.upper() for f in FUNCTIONS + ("atan", "exists")]
-            raise self.fail(f"unknown function {word.upper()!r}" + did_you_mean(word.upper(), names), pos)
+        if word not in _ALL_FUNCTIONS:
+            names = [f.upper() for f in _ALL_FUNCTIONS]
+            hint = did_you_mean(word.upper(), names)
+            raise self.fail(f"unknown function {word.upper()!r}{hint}", pos)
         p = pos + len(word)
         if not s.startswith("[", p):
             raise self.fail(f"{word.upper()} must be followed by '['", p)
@@ -347,7 +352,12 @@ def parse_value(code: CompactText, pos: int = 0) -> tuple[Node, int]:
 
     Raises
     ------
-    GcodeExpressionError, GcodeLimitError
+    GcodeExpressionError
+        Malformed text: an unclosed ``[``, a bad number (``1.2.3``, ``1e5``),
+        an unknown function or operator (with a did-you-mean), a function
+        without ``[``, ``ATAN`` without ``/[x]``, an unclosed ``#<name``.
+    GcodeLimitError
+        Values nested deeper than :data:`MAX_DEPTH`.
     """
     return _Parser(code).value(pos)
 
@@ -366,7 +376,8 @@ def parse(text: str) -> Node:
     code = compact(text)
     node, end = parse_value(code)
     if end < len(code.chars):
-        raise expression_error(f"unexpected text after the value: {code.chars[end:]!r}", code.column(end))
+        rest = code.chars[end:]
+        raise expression_error(f"unexpected text after the value: {rest!r}", code.column(end))
     return node
 
 
@@ -386,9 +397,9 @@ def evaluate(node: Node, parameters: Parameters) -> float:
     * ``SQRT`` of a negative number, ``LN`` of a number <= 0, and ``ACOS`` /
       ``ASIN`` outside [-1, 1] are errors.
     * ``FIX`` rounds down, ``FUP`` up, ``ROUND`` half away from zero.
-    * A numbered parameter's index must be within 0.0001 of an integer and,
-      like reading an undefined named parameter, is checked by
-      ``parameters.get``; ``EXISTS`` never fails on either.
+    * A numbered parameter's number must be within 0.0001 of an integer
+      (:func:`parameter_index`); ``parameters.get`` refuses numbers outside
+      1 .. 5601 and names never set, where ``EXISTS`` gives 0.
     * A result that is infinite or not a number is an error.
 
     Raises

@@ -48,6 +48,10 @@ O_WORD_MESSAGE = "O-word control flow is not supported yet (issue #4)"
 _O_WORD = re.compile(r"[ \t]*(?:/[ \t]*)?(?:[nN][0-9. \t]*)?([oO])")
 _SPACE = " \t\r\n\v\f"
 
+# (start, end, replacement) in the line's text, in order; and (key, value).
+_Edits = list[tuple[int, int, str]]
+_Assignments = list[tuple[int | str, float]]
+
 
 def needs_parameters(text: str) -> bool:
     """Whether ``text`` may hold a parameter or expression (a fast pre-check)."""
@@ -235,16 +239,14 @@ class ParameterStage:
             new = self._substitute(text)
         except GcodeError as exc:
             kind = "limit" if isinstance(exc, GcodeLimitError) else "expression"
-            where = exc.diagnostic
-            column = where.column if where is not None else 1
-            message = where.message if where is not None else str(exc)
-            diagnostics.report(line.line, column, message, text, kind=kind)
+            where = exc.diagnostic  # every error raised here is located
+            diagnostics.report(line.line, where.column, where.message, text, kind=kind)
             return dataclasses.replace(line, text="")
         return line if new == text else dataclasses.replace(line, text=new)
 
     def _substitute(self, text: str) -> str:
-        edits: list[tuple[int, int, str]] = []
-        assignments: list[tuple[int | str, float]] = []
+        edits: _Edits = []
+        assignments: _Assignments = []
         for start, end in self._code_ranges(text):
             self._scan(compact(text, start, end), text, edits, assignments)
         # RS274NGC sets parameters in parallel: only now that every value on
@@ -278,7 +280,7 @@ class ParameterStage:
         ranges.append((pos, len(text)))
         return ranges
 
-    def _scan(self, code: CompactText, text: str, edits: list, assignments: list) -> None:
+    def _scan(self, code: CompactText, text: str, edits: _Edits, assignments: _Assignments) -> None:
         """Find the values to replace and the assignments in one code range."""
         s, i = code.chars, 0
         while i < len(s):
@@ -286,7 +288,8 @@ class ParameterStage:
             if c == "#":
                 i = self._assignment(code, i, text, edits, assignments)
             elif c == "[":
-                raise expression_error("an expression must be the value of a word, as in X[...]", code.column(i))
+                message = "an expression must be the value of a word, as in X[...]"
+                raise expression_error(message, code.column(i))
             elif "a" <= c <= "z":
                 run = i + 1
                 while run < len(s) and "a" <= s[run] <= "z":
@@ -301,7 +304,9 @@ class ParameterStage:
             else:
                 i += 1
 
-    def _assignment(self, code: CompactText, pos: int, text: str, edits: list, assignments: list) -> int:
+    def _assignment(
+        self, code: CompactText, pos: int, text: str, edits: _Edits, assignments: _Assignments
+    ) -> int:
         """Read ``#target = value`` at ``pos``; return the position after it."""
         s = code.chars
         target, eq = parse_value(code, pos)
@@ -324,7 +329,8 @@ class ParameterStage:
         assert isinstance(target, Parameter)
         key = parameter_index(evaluate(target.index, self.store), target.column)
         if not 1 <= key <= MAX_PARAMETER:
-            raise expression_error(f"parameter number {key} is outside 1 .. {MAX_PARAMETER}", target.column)
+            message = f"parameter number {key} is outside 1 .. {MAX_PARAMETER}"
+            raise expression_error(message, target.column)
         return key
 
 

@@ -36,6 +36,7 @@ class Block:
     comments: tuple[str, ...] = ()
     flags: tuple[str, ...] = ()
     named: tuple[str, str] | None = None
+    text: str | None = None
     deleted: bool = False
 
 
@@ -101,6 +102,7 @@ class Blocks:
             comments=comments,
             flags=tuple(f for f, _ in extra.flags) if extra else (),
             named=extra.named[:2] if extra and extra.named else None,
+            text=extra.text if extra else None,
             deleted=bool(extra and extra.deleted),
         )
 
@@ -156,5 +158,6 @@ class Blocks:
             comment_col=np.array([c[1] for _, c in comments], np.int32),
             comment_offsets=offsets,
             comment_data=b"".join(encoded),
-            extras={i: b for i, b in enumerate(raw) if b.flags or b.named or b.code_value is not None or b.deleted},
+            extras={i: b for i, b in enumerate(raw)
+                    if b.flags or b.named or b.text or b.code_value is not None or b.deleted},
         )

@@ -26,11 +26,16 @@ class RawBlock:
     comments: list[tuple[str, int]] = field(default_factory=list)
     flags: list[tuple[str, int]] = field(default_factory=list)
     named: tuple[str, str, int] | None = None
+    text: str | None = None
     code_value: float | None = None
     deleted: bool = False
 
     def is_empty(self) -> bool:
-        return not (self.words or self.comments or self.flags or self.named)
+        return not (self.words or self.comments or self.flags or self.named or self.text)
+
+    def add_text(self, text: str) -> None:
+        """Keep a string argument (``M117 Hello``, ``P"MK3S"``) with the block."""
+        self.text = text if not self.text else f"{self.text} {text}"
 
 
 @dataclass(slots=True)
@@ -164,10 +169,22 @@ class LineTokenizer:
                 break
             j += 1
         number = text[start:j].replace(" ", "").replace("\t", "")
+        if fl.block_split == "single" and letter not in "GM":
+            if j < n and text[j] == '"':  # firmware string argument: P"MK3S"
+                end = text.find('"', j + 1)
+                end = n if end < 0 else end + 1
+                block.add_text(text[i:end].strip())
+                return end
+            if digits and j < n and (text[j] in "._" or text[j].isalnum()):
+                end = j  # a version or name such as U3.13.0 is kept as text
+                while end < n and not text[end].isspace() and text[end] not in fl.line_comments:
+                    end += 1
+                block.add_text(text[i:end])
+                return end
         if digits == 0:
-            if fl.block_split == "single" and (j >= n or not text[j].isdigit()):
+            if fl.block_split == "single" and letter not in "GM" and (j >= n or not text[j].isdigit()):
                 block.flags.append((letter, col))
-                return start if start > i + 1 else i + 1
+                return max(j, i + 1)
             self.diagnostics.report(block.line, col, f"word {letter!r} has no number", text)
             return max(j, i + 1)
         block.words.append((letter, float(number), col))
@@ -187,7 +204,7 @@ class LineTokenizer:
             if code in ("M117", "M118"):  # the message is the whole rest of the line
                 cut = -1
             arg = rest if cut < 0 else rest[:cut]
-            block.named = (code, arg.strip(), col)
+            block.add_text(arg.strip())
             if cut >= 0:
                 block.comments.append((rest[cut + 1 :].strip(), j + cut + 1))
             return n
