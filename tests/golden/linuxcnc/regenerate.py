@@ -1,0 +1,242 @@
+#!/usr/bin/env python3
+"""Select and copy the LinuxCNC golden cases from the shared corpus.
+
+Reference: LinuxCNC 2.9.0~pre1 ``rs274`` (Debian 12 package linuxcnc-uspace),
+run headless by ``../shared/tools/linuxcnc/run_rs274.sh`` and tabulated by
+``canon_to_csv.py --src``.
+
+A program qualifies when ``RESULTS.tsv`` marks it ``ok``, it has motions, all
+of them matched to a source line (``line_match == ok``), no rotary-axis work
+or G92 offset is active (the CSV only carries X/Y/Z offsets), and its text
+(comments stripped) uses only the foundation features: no O-words or
+subprograms, cutter compensation, canned or lathe cycles, threading, probing,
+splines, lathe modes, G10, tool length offsets, G52, polar words, I/O M-codes,
+user or unknown codes, or system parameters.
+
+Usage::
+
+    python tests/golden/linuxcnc/regenerate.py [--corpus DIR] [--rerun]
+
+``--rerun`` re-runs ``/usr/bin/rs274`` on every case first (the corpus
+``.canon.csv`` files are used otherwise).  Writes ``manifest.tsv`` and
+``cases/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+CASES = HERE / "cases"
+MANIFEST = HERE / "manifest.tsv"
+SHARED = HERE.parents[3] / "shared"
+TOOLS = SHARED / "tools" / "linuxcnc"
+RS274 = Path("/usr/bin/rs274")
+REFERENCE = "LinuxCNC 2.9.0~pre1 rs274 (Debian 12 linuxcnc-uspace)"
+
+COMMENT = re.compile(r"\([^)]*\)|;.*")
+NAMED = re.compile(r"#<([^>]*)>")
+ANGLED = re.compile(r"<[^>]*>")
+LETTER_RUN = re.compile(r"[A-Z]{2,}")  # functions, operators and O-word keywords
+CODE = re.compile(r"(?<![A-Z])([GM])(\d+(?:\.\d+)?)")
+COMPUTED_CODE = re.compile(r"(?<![A-Z])[GM][\[#]")
+OWORD = re.compile(r"(?<![A-Z])O[\d<\[#]")
+SYSTEM_NUMBERED = re.compile(r"#5\d{3}(?!\d)")
+POLAR = re.compile(r"[@^]")
+
+#: Predefined (read-only) named parameters of LinuxCNC 2.9.
+SYSTEM_NAMED = frozenset("""
+_vmajor _vminor _line _motion_mode _plane _ccomp _metric _imperial _absolute
+_incremental _inverse_time _units_per_minute _units_per_rev _coord_system
+_tool_offset _retract_r_level _retract_old_z _spindle_rpm_mode _spindle_css_mode
+_ijk_absolute_mode _lathe_diameter_mode _lathe_radius_mode _spindle_on
+_spindle_cw _mist _flood _speed_override _feed_override _adaptive_feed
+_feed_hold _feed _rpm _x _y _z _a _b _c _u _v _w _abs_x _abs_y _abs_z _abs_a
+_abs_b _abs_c _current_tool _current_pocket _selected_tool _selected_pocket
+_value _value_returned _task _call_level _remap_level
+""".split())
+
+#: G-codes (as written, leading zeros dropped) outside the foundation issue.
+EXCLUDED_G = {
+    **dict.fromkeys(("41", "41.1", "42", "42.1"), "cutter compensation"),
+    **dict.fromkeys(("73", "74", "76", "81", "82", "83", "84", "85", "86", "87",
+                     "88", "89"), "canned cycle"),
+    **dict.fromkeys(("33", "33.1"), "threading"),
+    **dict.fromkeys(("38.2", "38.3", "38.4", "38.5"), "probing"),
+    **dict.fromkeys(("5", "5.1", "5.2", "5.3"), "spline"),
+    **dict.fromkeys(("7", "8"), "lathe diameter/radius mode"),
+    "10": "G10 table write",
+    **dict.fromkeys(("43", "43.1", "43.2"), "tool length offset"),
+    "52": "local offset",
+    **dict.fromkeys(("70", "71", "71.1", "71.2", "72", "72.1", "72.2"), "lathe cycle"),
+}
+ALLOWED_G = frozenset("""
+0 1 2 3 4 17 17.1 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 49 53 54 55 56 57 58
+59 59.1 59.2 59.3 61 61.1 64 80 90 90.1 91 91.1 92 92.1 92.2 92.3 93 94 95 96 97
+98 99
+""".split())
+EXCLUDED_M = {
+    **dict.fromkeys(("98", "99"), "subprogram"),
+    **dict.fromkeys(tuple(str(n) for n in range(62, 69)), "digital/analog I/O"),
+}
+ALLOWED_M = frozenset("0 1 2 3 4 5 6 7 8 9 19 30 48 49 50 51 52 53 60 61 70 71 72 73".split())
+
+
+@dataclass
+class Entry:
+    """One corpus program and the verdict on it."""
+
+    program: str
+    motions: int
+    golden: bool
+    reason: str
+
+
+def normalize(code: str) -> str:
+    """``"01"`` -> ``"1"``, ``"38.20"`` -> ``"38.2"``."""
+    whole, _, frac = code.partition(".")
+    frac = frac.rstrip("0")
+    return str(int(whole)) + ("." + frac if frac else "")
+
+
+def scan_text(text: str) -> tuple[list[str], list[str]]:
+    """Return (exclusion reasons, codes used) for a program's text."""
+    reasons: dict[str, None] = {}
+    body = "\n".join(COMMENT.sub("", line) for line in text.upper().splitlines())
+    body = re.sub(r"[ \t\r]", "", body)
+    for name in NAMED.findall(body):
+        key = name.lower()
+        if key in SYSTEM_NAMED or key.startswith(("_ini[", "_hal[")):
+            reasons[f"system parameter #<{key}>"] = None
+    body = ANGLED.sub("<>", body)
+    if OWORD.search(body):
+        reasons["O-word"] = None
+    body = LETTER_RUN.sub(" ", body)
+    if SYSTEM_NUMBERED.search(body):
+        reasons["system parameter #5xxx"] = None
+    if POLAR.search(body):
+        reasons["polar coordinates"] = None
+    if COMPUTED_CODE.search(body):
+        reasons["computed G/M code"] = None
+    used: dict[str, None] = {}
+    for letter, raw in CODE.findall(body):
+        code = normalize(raw)
+        used[letter + code] = None
+        if letter == "G":
+            why = EXCLUDED_G.get(code) or (None if code in ALLOWED_G else "unknown or remapped code")
+        else:
+            why = EXCLUDED_M.get(code) or (None if code in ALLOWED_M else "user or remapped M-code")
+        if why:
+            reasons[f"{why} ({letter}{code})"] = None
+    return list(reasons), sorted(used, key=lambda c: (c[0], float(c[1:])))
+
+
+def scan_canon(canon: Path) -> list[str]:
+    """Exclusion reasons found in the raw canon stream (offsets the CSV lacks)."""
+    reasons = []
+    for line in canon.read_text(errors="replace").splitlines():
+        for name in ("SET_G5X_OFFSET", "SET_G92_OFFSET"):
+            if name + "(" in line:
+                args = [float(v) for v in line.split("(", 1)[1].rstrip(") ").split(",")]
+                abc = args[4:7] if name == "SET_G5X_OFFSET" else args[3:6]
+                if any(abc):
+                    reasons.append("rotary-axis offset not in the CSV")
+    return sorted(set(reasons))
+
+
+def scan_csv(path: Path) -> tuple[int, list[str]]:
+    """Return (motion count, exclusion reasons) of a ``.canon.csv``."""
+    with path.open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    bad = sum(r["line_match"] != "ok" for r in rows)
+    reasons = [f"{bad} motion(s) with line_match != ok"] if bad else []
+    if not rows:
+        reasons.append("no motions")
+    return len(rows), reasons
+
+
+def rerun(program: Path, table: Path | None, out: Path) -> None:
+    """Regenerate ``out`` (a ``.canon.csv``) with rs274 and canon_to_csv.py."""
+    with tempfile.TemporaryDirectory() as tmp:
+        canon = Path(tmp) / "out.canon"
+        cmd = [str(TOOLS / "run_rs274.sh"), str(program)] + ([str(table)] if table else [])
+        with canon.open("w") as f:
+            subprocess.run(cmd, stdout=f, check=True)
+        cmd = [sys.executable, str(TOOLS / "canon_to_csv.py"), str(canon), "-o", str(out),
+               "--src", str(program)] + (["--tbl", str(table)] if table else [])
+        subprocess.run(cmd, check=True)
+
+
+def read_tables(corpus: Path) -> dict[str, Path]:
+    """Per-program tool tables from ``TOOLTABLE_OVERRIDES.tsv``."""
+    tables = {}
+    for line in (corpus / "TOOLTABLE_OVERRIDES.tsv").read_text().splitlines():
+        if line.strip() and not line.startswith("#"):
+            program, table = line.split("\t")[:2]
+            tables[program] = corpus / table
+    return tables
+
+
+def case_name(program: str) -> str:
+    """Flat file name of a case: ``nc_files/a/b.ngc`` -> ``a__b.ngc``."""
+    return program.removeprefix("nc_files/").replace("/", "__")
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--corpus", type=Path, default=SHARED / "corpus" / "linuxcnc")
+    ap.add_argument("--rerun", action="store_true", help=f"re-run {RS274} for every case")
+    args = ap.parse_args(argv)
+    if args.rerun and not RS274.exists():
+        ap.error(f"--rerun needs {RS274} (apt-get install -y --no-install-recommends linuxcnc-uspace)")
+    corpus: Path = args.corpus
+    tables = read_tables(corpus)
+    with (corpus / "RESULTS.tsv").open(newline="") as f:
+        results = list(csv.DictReader(f, delimiter="\t"))
+
+    entries: list[Entry] = []
+    chosen: list[tuple[str, Path]] = []
+    for row in results:
+        program = row["file"]
+        path = corpus / program
+        if row["status"] != "ok":
+            entries.append(Entry(program, int(row["motions"] or 0), False, f"rs274 {row['status']}"))
+            continue
+        reasons, used = scan_text(path.read_text(errors="replace"))
+        reasons += scan_canon(path.with_name(path.name + ".canon"))
+        expected = path.with_name(path.name + ".canon.csv")
+        if args.rerun and not reasons:
+            expected = Path(tempfile.mkdtemp()) / (path.name + ".canon.csv")
+            rerun(path, tables.get(program), expected)
+        motions, csv_reasons = scan_csv(expected)
+        reasons += csv_reasons
+        entries.append(Entry(program, motions, not reasons, "; ".join(reasons) or " ".join(used)))
+        if not reasons:
+            chosen.append((program, expected))
+
+    CASES.mkdir(exist_ok=True)
+    for old in CASES.iterdir():
+        old.unlink()
+    for program, expected in chosen:
+        name = case_name(program)
+        shutil.copyfile(corpus / program, CASES / name)
+        shutil.copyfile(expected, CASES / (name + ".canon.csv"))
+    with MANIFEST.open("w", newline="") as f:
+        w = csv.writer(f, delimiter="\t", lineterminator="\n")
+        w.writerow(["program", "motions", "golden", "reason"])
+        for e in sorted(entries, key=lambda e: (not e.golden, e.program)):
+            w.writerow([e.program, e.motions, "yes" if e.golden else "no", e.reason])
+    print(f"{len(chosen)} of {len(entries)} programs are golden cases ({REFERENCE})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
