@@ -11,7 +11,7 @@ Examples
 >>> from gcodekit.parse import GcodeParser
 >>> table = GcodeParser("rs274ngc").parse(read_text("G1 X1 F100\\nY2\\n"))
 >>> [str(table.command(i)) for i in range(len(table))]
-['G1 F100 X1', ' Y2']
+['G1 F100 X1', 'Y2']
 """
 
 from __future__ import annotations

@@ -1,0 +1,135 @@
+"""Golden tests: motions of LinuxCNC example programs against rs274's canon.
+
+Cases and their reference tables sit in ``tests/golden/linuxcnc/cases`` (see
+the README there; ``regenerate.py`` selects and refreshes them).  The canon
+gives program coordinates plus the offsets in force, so each reference row is
+moved to machine coordinates first: rotate(program + G92, XY rotation) + G5x
++ tool offset, all in the program units of that move.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import gcodekit
+
+CASES = Path(__file__).parent / "golden" / "linuxcnc" / "cases"
+PROGRAMS = sorted(p.name for p in CASES.glob("*.ngc"))
+ATOL, RTOL = 1e-4, 1e-9
+AXES = ["x", "y", "z", "a", "b", "c"]
+CENTRE = ["cx", "cy", "cz"]
+CANON_MOTION = {"STRAIGHT_TRAVERSE": "rapid", "STRAIGHT_FEED": "feed"}
+
+
+def to_machine(x: np.ndarray, y: np.ndarray, z: np.ndarray,
+               ref: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Program coordinates of canon rows -> machine coordinates."""
+    px, py = x + ref["g92_x"], y + ref["g92_y"]
+    angle = np.radians(ref["xy_rot"])
+    cos, sin = np.cos(angle), np.sin(angle)
+    mx = px * cos - py * sin + ref["g5x_x"] + ref["tlo_x"]
+    my = px * sin + py * cos + ref["g5x_y"]
+    mz = z + ref["g92_z"] + ref["g5x_z"] + ref["tlo_z"]
+    return mx.to_numpy(), my.to_numpy(), mz.to_numpy()
+
+
+def reference_motions(csv_path: Path) -> pd.DataFrame:
+    """A ``.canon.csv`` as a table shaped like :meth:`Operation.motions`."""
+    ref = pd.read_csv(csv_path, keep_default_na=False, na_values=[""])
+    motion = ref["type"].map(CANON_MOTION)
+    arc = ref["type"] == "ARC_FEED"
+    motion[arc] = np.where(ref.loc[arc, "arc_rotation"] < 0, "arc_cw", "arc_ccw")
+    out = pd.DataFrame({"src_line": ref["src_line"], "motion": motion.fillna(ref["type"])})
+    out["x"], out["y"], out["z"] = to_machine(ref["x"], ref["y"], ref["z"], ref)
+    for key in "abc":
+        out[key] = ref[key]
+    # The helix-axis coordinate of a centre is empty: transform with the end
+    # point's coordinate there, then blank it again.
+    centre = [ref[f"arc_{k}"].fillna(ref[k[1]]) for k in CENTRE]
+    for key, value in zip(CENTRE, to_machine(*centre, ref)):
+        out[key] = np.where(ref[f"arc_{key}"].isna(), np.nan, value)
+    out["feed"] = ref["feed"]
+    out["feed_mode"] = ref["feed_mode"]
+    out["plane"], out["units"] = ref["plane"], ref["units"]
+    return out
+
+
+def first_difference(ours: pd.DataFrame, ref: pd.DataFrame, exact: list[str],
+                     close: list[str]) -> str | None:
+    """Describe the first row where the tables differ, or None.
+
+    ``exact`` columns must be equal; ``close`` columns must agree within
+    ATOL + RTOL * |reference| wherever the reference has a value.
+    """
+    n = min(len(ours), len(ref))
+    a, b = ours.iloc[:n].reset_index(drop=True), ref.iloc[:n].reset_index(drop=True)
+    bad = pd.DataFrame(index=range(n))
+    for key in exact:
+        bad[key] = a[key].to_numpy() != b[key].to_numpy()
+    for key in close:
+        want, got = b[key].to_numpy(float), a[key].to_numpy(float)
+        ok = np.abs(got - want) <= ATOL + RTOL * np.abs(want)
+        bad[key] = ~np.isnan(want) & ~ok
+    rows = np.flatnonzero(bad.to_numpy().any(axis=1))
+    if len(rows) == 0:
+        return None if len(ours) == len(ref) else (
+            f"motion count differs: ours {len(ours)}, rs274 {len(ref)}; "
+            f"first extra row (ours line {ours['line'].iloc[n] if n < len(ours) else '-'}, "
+            f"rs274 source line {ref['src_line'].iloc[n] if n < len(ref) else '-'})")
+    i = rows[0]
+    cols = [k for k in exact + close if bad.at[i, k]]
+    shown = list(dict.fromkeys(["motion"] + cols + AXES + CENTRE))
+    table = pd.DataFrame({"ours": a.loc[i, shown], "rs274": b.loc[i, shown]})
+    return (f"{len(rows)} of {n} motions differ (counts: ours {len(ours)}, rs274 {len(ref)}); "
+            f"first at motion {i}, rs274 source line {b.at[i, 'src_line']}, ours line "
+            f"{a.at[i, 'line']}, in {cols}:\n{table.to_string()}")
+
+
+@cache
+def motions(name: str) -> tuple[pd.DataFrame, pd.DataFrame, list]:
+    """(our motions, reference motions, diagnostics) of one case."""
+    op = gcodekit.gcode_to_operation(CASES / name, machine="linuxcnc")
+    return op.motions(), reference_motions(CASES / (name + ".canon.csv")), op.diagnostics.items
+
+
+def test_cases_present() -> None:
+    assert PROGRAMS, f"no golden cases in {CASES}; run tests/golden/linuxcnc/regenerate.py"
+
+
+@pytest.mark.parametrize("name", PROGRAMS)
+def test_motions_match_rs274(name: str) -> None:
+    """Type, end point and arc centre of every motion, in order, and the count."""
+    ours, ref, diagnostics = motions(name)
+    problem = first_difference(ours, ref, ["motion", "units", "plane"], AXES + CENTRE)
+    assert problem is None, f"{name}: {problem}\ndiagnostics: {diagnostics[:5]}"
+
+
+@pytest.mark.parametrize("name", PROGRAMS)
+def test_feeds_match_rs274(name: str) -> None:
+    """Feed of every motion in units per minute mode (G94)."""
+    ours, ref, _ = motions(name)
+    if len(ours) != len(ref):
+        pytest.skip("motion counts differ (see test_motions_match_rs274)")
+    keep = (ref["feed_mode"] == 0).to_numpy()
+    ours, ref = ours[keep].copy(), ref[keep].copy()
+    ours["feed"] = ours["feed"].fillna(-1.0)  # rapids: NaN on both sides
+    ref["feed"] = ref["feed"].fillna(-1.0)
+    problem = first_difference(ours, ref, [], ["feed"])
+    assert problem is None, f"{name}: {problem}"
+
+
+@pytest.mark.parametrize("name", PROGRAMS)
+def test_source_lines_match_rs274(name: str) -> None:
+    """Every motion names the source line LinuxCNC's gcode module reports."""
+    ours, ref, _ = motions(name)
+    if len(ours) != len(ref):
+        pytest.skip("motion counts differ (see test_motions_match_rs274)")
+    ours = ours.assign(src=ours["line"].astype("int64"))
+    ref = ref.assign(src=ref["src_line"].astype("int64"))
+    problem = first_difference(ours, ref, ["src"], [])
+    assert problem is None, f"{name}: {problem}"
