@@ -151,6 +151,10 @@ def scan(data: bytes, flavor: Flavor) -> ScanResult:
     value = mantissa / _POW10[np.clip(frac_seg[words], 0, 22)]
     value[ob[np.minimum(starts + 1, ob.size - 1)] == ord("-")] *= -1.0
 
+    code_letter = ob[starts] & 0xDF
+    odd_code = ((code_letter == ord("G")) | (code_letter == ord("M"))) & ~((value >= 0) & (value < 10000))
+    line_ok[token_line[odd_code]] = False  # the reference tokenizer reports it
+
     keep_tok = line_ok[token_line]
     word_line = token_line[keep_tok]
     word_pos = pos[starts[keep_tok]]

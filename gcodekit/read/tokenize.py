@@ -15,6 +15,8 @@ from ..syntax import Flavor
 
 _DIGITS = "0123456789"
 _SPACE = " \t\r\f\v"
+#: No machine takes coordinates this large; longer numbers are typos or garbage.
+_LARGEST = 1e15
 
 
 @dataclass(slots=True)
@@ -187,7 +189,11 @@ class LineTokenizer:
                 return max(j, i + 1)
             self.diagnostics.report(block.line, col, f"word {letter!r} has no number", text)
             return max(j, i + 1)
-        block.words.append((letter, float(number), col))
+        value = float(number)
+        if not abs(value) < _LARGEST or (letter in "GM" and not 0 <= value < 10000):
+            self.diagnostics.report(block.line, col, f"number out of range for {letter}", text)
+            return j
+        block.words.append((letter, value, col))
         if fl.code_assignments and j < n and text[j] == "=" and letter in "GM":
             k = j + 1
             while k < n and (text[k] in _DIGITS or text[k] in ".+-"):

@@ -163,16 +163,14 @@ def scan_csv(path: Path) -> tuple[int, list[str]]:
     return len(rows), reasons
 
 
-def rerun(program: Path, table: Path | None, out: Path) -> None:
-    """Regenerate ``out`` (a ``.canon.csv``) with rs274 and canon_to_csv.py."""
-    with tempfile.TemporaryDirectory() as tmp:
-        canon = Path(tmp) / "out.canon"
-        cmd = [str(TOOLS / "run_rs274.sh"), str(program)] + ([str(table)] if table else [])
-        with canon.open("w") as f:
-            subprocess.run(cmd, stdout=f, check=True)
-        cmd = [sys.executable, str(TOOLS / "canon_to_csv.py"), str(canon), "-o", str(out),
-               "--src", str(program)] + (["--tbl", str(table)] if table else [])
-        subprocess.run(cmd, check=True)
+def rerun(program: Path, table: Path | None, canon: Path) -> None:
+    """Run rs274 on ``program`` into ``canon`` and tabulate it into ``canon`` + ``.csv``."""
+    cmd = [str(TOOLS / "run_rs274.sh"), str(program)] + ([str(table)] if table else [])
+    with canon.open("w") as f:
+        subprocess.run(cmd, stdout=f, check=True)
+    cmd = [sys.executable, str(TOOLS / "canon_to_csv.py"), str(canon), "-o", f"{canon}.csv",
+           "--src", str(program)] + (["--tbl", str(table)] if table else [])
+    subprocess.run(cmd, check=True)
 
 
 def read_tables(corpus: Path) -> dict[str, Path]:
@@ -190,6 +188,25 @@ def case_name(program: str) -> str:
     return program.removeprefix("nc_files/").replace("/", "__")
 
 
+def judge(corpus: Path, row: dict[str, str], tables: dict[str, Path],
+          rerun_dir: Path | None) -> Entry:
+    """Decide on one ``RESULTS.tsv`` row; with ``rerun_dir``, run rs274 afresh into it."""
+    program = row["file"]
+    path = corpus / program
+    if row["status"] != "ok":
+        error = " ".join(row["error"].split())[:80]
+        return Entry(program, int(row["motions"] or 0), False, f"rs274 {row['status']}: {error}")
+    reasons, used = scan_text(path.read_text(errors="replace"))
+    canon = path.with_name(path.name + ".canon")
+    if rerun_dir is not None and not reasons:
+        canon = rerun_dir / (case_name(program) + ".canon")
+        rerun(path, tables.get(program), canon)
+    reasons += scan_canon(canon)
+    motions, csv_reasons = scan_csv(canon.with_name(canon.name + ".csv"))
+    reasons += csv_reasons
+    return Entry(program, motions, not reasons, "; ".join(reasons) or "uses " + " ".join(used))
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--corpus", type=Path, default=SHARED / "corpus" / "linuxcnc")
@@ -203,32 +220,22 @@ def main(argv: list[str] | None = None) -> int:
         results = list(csv.DictReader(f, delimiter="\t"))
 
     entries: list[Entry] = []
-    chosen: list[tuple[str, Path]] = []
-    for row in results:
-        program = row["file"]
-        path = corpus / program
-        if row["status"] != "ok":
-            entries.append(Entry(program, int(row["motions"] or 0), False, f"rs274 {row['status']}"))
-            continue
-        reasons, used = scan_text(path.read_text(errors="replace"))
-        reasons += scan_canon(path.with_name(path.name + ".canon"))
-        expected = path.with_name(path.name + ".canon.csv")
-        if args.rerun and not reasons:
-            expected = Path(tempfile.mkdtemp()) / (path.name + ".canon.csv")
-            rerun(path, tables.get(program), expected)
-        motions, csv_reasons = scan_csv(expected)
-        reasons += csv_reasons
-        entries.append(Entry(program, motions, not reasons, "; ".join(reasons) or " ".join(used)))
-        if not reasons:
-            chosen.append((program, expected))
-
-    CASES.mkdir(exist_ok=True)
-    for old in CASES.iterdir():
-        old.unlink()
-    for program, expected in chosen:
-        name = case_name(program)
-        shutil.copyfile(corpus / program, CASES / name)
-        shutil.copyfile(expected, CASES / (name + ".canon.csv"))
+    with tempfile.TemporaryDirectory() as tmp:
+        chosen: list[str] = []
+        for row in results:
+            entry = judge(corpus, row, tables, Path(tmp) if args.rerun else None)
+            entries.append(entry)
+            if entry.golden:
+                chosen.append(entry.program)
+        CASES.mkdir(exist_ok=True)
+        for old in CASES.iterdir():
+            old.unlink()
+        for program in chosen:
+            name = case_name(program)
+            fresh = Path(tmp) / (name + ".canon.csv")
+            expected = fresh if args.rerun else corpus / (program + ".canon.csv")
+            shutil.copyfile(corpus / program, CASES / name)
+            shutil.copyfile(expected, CASES / (name + ".canon.csv"))
     with MANIFEST.open("w", newline="") as f:
         w = csv.writer(f, delimiter="\t", lineterminator="\n")
         w.writerow(["program", "motions", "golden", "reason"])
