@@ -136,3 +136,17 @@ def test_source_lines_match_rs274(name: str) -> None:
     problem = first_difference(ours, ref, ["src"], [])
     if problem is not None:
         pytest.fail(f"{name}: {problem}", pytrace=False)
+
+
+def test_reference_offsets_applied(tmp_path: Path) -> None:
+    """G92, XY rotation, G5x and tool offsets move canon rows to machine coordinates."""
+    header = ("idx,src_line,line_match,type,x,y,z,a,b,c,feed,feed_mode,units,plane,arc_rotation,"
+              "arc_cx,arc_cy,arc_cz,g5x_x,g5x_y,g5x_z,g92_x,g92_y,g92_z,xy_rot,tlo_x,tlo_z")
+    row = "0,7,ok,ARC_FEED,1,0,0,0,0,0,100,0,mm,XY,-1,1,1,,10,20,3,1,0,0,90,0,0.5"
+    path = tmp_path / "t.canon.csv"
+    path.write_text(header + "\n" + row + "\n")
+    ref = reference_motions(path).iloc[0]
+    assert ref["motion"] == "arc_cw"
+    assert np.allclose(ref[["x", "y", "z"]].to_numpy(float), [10.0, 22.0, 3.5])
+    assert np.allclose(ref[["cx", "cy"]].to_numpy(float), [9.0, 22.0])
+    assert np.isnan(ref["cz"])

@@ -130,10 +130,8 @@ def scan_text(text: str) -> tuple[list[str], list[str]]:
     for letter, raw in CODE.findall(body):
         code = normalize(raw)
         used[letter + code] = None
-        if letter == "G":
-            why = EXCLUDED_G.get(code) or (None if code in ALLOWED_G else "unknown or remapped code")
-        else:
-            why = EXCLUDED_M.get(code) or (None if code in ALLOWED_M else "user or remapped M-code")
+        excluded, allowed = (EXCLUDED_G, ALLOWED_G) if letter == "G" else (EXCLUDED_M, ALLOWED_M)
+        why = excluded.get(code) or (None if code in allowed else "unknown, user or remapped code")
         if why:
             reasons[f"{why} ({letter}{code})"] = None
     return list(reasons), sorted(used, key=lambda c: (c[0], float(c[1:])))
@@ -213,7 +211,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--rerun", action="store_true", help=f"re-run {RS274} for every case")
     args = ap.parse_args(argv)
     if args.rerun and not RS274.exists():
-        ap.error(f"--rerun needs {RS274} (apt-get install -y --no-install-recommends linuxcnc-uspace)")
+        ap.error(f"--rerun needs {RS274}: apt-get install -y --no-install-recommends "
+                 "linuxcnc-uspace")
     corpus: Path = args.corpus
     tables = read_tables(corpus)
     with (corpus / "RESULTS.tsv").open(newline="") as f:

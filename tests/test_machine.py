@@ -1,0 +1,233 @@
+"""Emulate stage: modal machine behaviour against values worked out by hand."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import gcodekit
+
+
+def run(text: str, machine: str = "linuxcnc", **kw):
+    op = gcodekit.gcode_to_operation(text, machine, **kw)
+    return op, op.to_dataframe()
+
+
+def end(op, i=-1):
+    return op.process_data[i].location[:3]
+
+
+def test_units_switch_mid_program():
+    op, df = run("G21 G1 X10 F100\nG20 X1\nG21 Y5\n")
+    assert end(op, 1) == (10.0, 0.0, 0.0)
+    assert end(op, 3) == pytest.approx((25.4, 0.0, 0.0))
+    assert end(op, 5) == pytest.approx((25.4, 5.0, 0.0))
+    assert df["distance"].iloc[3] == pytest.approx(15.4)
+    # the feed in force keeps its speed across G20 (LinuxCNC converts it to 3.937 in/min)
+    assert df["time"].iloc[3] == pytest.approx(15.4 / (100 / 60))
+    assert op.motions()["feed"].iloc[1] == pytest.approx(100 / 25.4)
+
+
+def test_incremental_and_absolute_mixed():
+    op, _ = run("G21 G90 G0 X10 Y10\nG91 G1 X5 Y-2 F60\nX5\nG90 X0\n")
+    assert op.process_data[-1].location[:2] == (0.0, 8.0)
+    frame = op.motions()
+    assert frame[["x", "y"]].values.tolist() == [[10, 10], [15, 8], [20, 8], [0, 8]]
+
+
+def test_work_offsets_and_g92_family():
+    text = "\n".join([
+        "G21 G90",
+        "G55 G0 X0 Y0",       # G55 = (100, 50, 0) from the preset override
+        "G92 X10 Y10",        # the current point (100, 50) is now (10, 10)
+        "G0 X20 Y10",         # machine (110, 50)
+        "G92.2",              # suspend: program coordinates are G55 again
+        "G0 X0 Y0",           # machine (100, 50)
+        "G92.3",              # restore the offset (-> program (0,0) is machine (90, 40))
+        "G0 X0 Y0",
+        "G92.1",
+        "G54 G0 X1 Y2",
+    ]) + "\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", work_offsets={"G55": (100.0, 50.0, 0.0)})
+    m = op.motions()[["x", "y"]].values.tolist()
+    assert m == [[100, 50], [110, 50], [100, 50], [90, 40], [1, 2]]
+
+
+def test_g28_goes_through_the_given_point_to_the_stored_position():
+    op, _ = run("G21 G0 X10 Y10 Z5\nG28.1\nG0 X0 Y0 Z0\nG28 Z8\n")
+    m = op.motions()
+    # via the intermediate point (0, 0, 8), then only Z to the stored 5
+    assert m[["x", "y", "z"]].values.tolist()[-2:] == [[0, 0, 8], [0, 0, 5]]
+    assert (m["line"].iloc[-2], m["line"].iloc[-1]) == (4, 4)
+    assert len(op.process_data) == len(op.commands)
+
+
+def test_marlin_g28_homes_named_axes():
+    op, _ = run("G1 X10 Y20 Z5 F600\nG28 X\nG28\n", "marlin")
+    assert end(op, 1) == (0.0, 20.0, 5.0)
+    assert end(op, 2) == (0.0, 0.0, 0.0)
+
+
+def test_g53_moves_in_machine_coordinates_once():
+    op = gcodekit.gcode_to_operation("G21 G55 G0 X1\nG53 G0 X5\nX2\n", "linuxcnc", work_offsets={"G55": (100.0, 0, 0)})
+    assert op.motions()["x"].tolist() == [101.0, 5.0, 102.0]
+
+
+@pytest.mark.parametrize("plane, words, center, endpoint", [
+    ("G17", "X10 Y10 I0 J10", (0, 10, None), (10, 10, 0)),
+    ("G18", "X10 Z10 I10 K0", (10, None, 0), (10, 0, 10)),
+    ("G19", "Y10 Z10 J0 K10", (None, 0, 10), (0, 10, 10)),
+])
+def test_arc_planes(plane, words, center, endpoint):
+    op, df = run(f"G21 {plane} G2 {words} F100\n")
+    row = op.motions().iloc[0]
+    assert (row.x, row.y, row.z) == pytest.approx(endpoint)
+    got = (row.cx, row.cy, row.cz)
+    for g, c in zip(got, center):
+        assert (math.isnan(g) if c is None else g == pytest.approx(c))
+    # clockwise seen with the plane's first axis right and second up: three quarters
+    assert df["distance"].iloc[-1] == pytest.approx(0.75 * 2 * math.pi * 10)
+
+
+def test_arc_lengths_quarter_half_full_and_helix():
+    # CW from (10,0) about the origin to (0,-10): a quarter turn of radius 10
+    _, df = run("G21 G0 X10 Y0\nG2 X0 Y-10 I-10 J0 F600\n")
+    assert df["distance"].iloc[-1] == pytest.approx(math.pi * 5)
+    # CCW the same way round is three quarters
+    _, df = run("G21 G0 X10 Y0\nG3 X0 Y-10 I-10 J0 F600\n")
+    assert df["distance"].iloc[-1] == pytest.approx(math.pi * 15)
+    # a full circle with a 4 mm rise, two turns (P2)
+    _, df = run("G21 G0 X10 Y0\nG2 X10 Y0 Z4 I-10 J0 P2 F600\n")
+    assert df["distance"].iloc[-1] == pytest.approx(math.hypot(2 * 2 * math.pi * 10, 4))
+
+
+def test_radius_form_short_and_long_arcs():
+    op, _ = run("G21 G0 X0 Y0\nG2 X10 Y0 R5 F100\nG0 X0 Y0\nG2 X10 Y0 R-7.0710678118654755\nG0 X0 Y0\nG3 X10 Y0 R7.0710678118654755\n")
+    m = op.motions()
+    # R5 over a 10 mm chord is a half circle centred on the chord
+    assert (m.cx.iloc[1], m.cy.iloc[1]) == pytest.approx((5, 0))
+    # negative R: the long way round, centre to the left of travel for G2
+    assert (m.cx.iloc[3], m.cy.iloc[3]) == pytest.approx((5, 5))
+    # G3 with positive R: the short arc, centre to the left as well
+    assert (m.cx.iloc[5], m.cy.iloc[5]) == pytest.approx((5, 5))
+
+
+def test_absolute_arc_centres_g90_1():
+    op, _ = run("G21 G0 X10 Y0\nG90.1 G3 X-10 Y0 I0 J0 F100\n")
+    assert (op.motions().cx.iloc[-1], op.motions().cy.iloc[-1]) == (0.0, 0.0)
+
+
+def test_arc_radius_mismatch_is_reported():
+    op, _ = run("G21 G0 X10 Y0\nG2 X0 Y-12 I-10 J0 F100\n")
+    assert any("radius" in d.message and d.line == 2 for d in op.diagnostics)
+
+
+def test_inverse_time_feed():
+    _, df = run("G21 G93 G1 X30 F2\n")  # each move takes 1/F minutes
+    assert df["time"].iloc[-1] == pytest.approx(30.0)
+
+
+def test_dwell_units_follow_the_machine():
+    _, lin = run("G4 P1.5\n", "linuxcnc")
+    _, mar = run("G4 P1500\nG4 S2\n", "marlin")
+    assert lin["time"].sum() == pytest.approx(1.5)
+    assert mar["time"].tolist() == pytest.approx([1.5, 2.0])
+
+
+def test_extrusion_absolute_relative_and_g92_e():
+    op, df = run("M82\nG1 X10 E1 F600\nG1 X20 E3\nG92 E0\nG1 X30 E0.5\nM83\nG1 X40 E0.25\nG1 E-0.8\n", "marlin")
+    assert df["de"].tolist() == pytest.approx([0, 1, 2, 0, 0.5, 0, 0.25, -0.8])
+    assert op.get_statistics()["filament_mm"] == pytest.approx(2.95)
+    assert [c.kind.name for c in op.commands[6:8]] == ["MOVE_EXTRUDE", "EXTRUDE"]
+
+
+def test_rapid_speed_depends_on_firmware():
+    _, lin = run("G21 G0 X50\n", "linuxcnc")  # 3000 mm/min preset rapid rate
+    _, mar = run("G1 F600\nG0 X50\n", "marlin")  # Marlin's G0 uses the modal feed
+    assert lin["time"].iloc[-1] == pytest.approx(1.0)
+    assert mar["time"].iloc[-1] == pytest.approx(5.0)
+
+
+def test_tools_spindle_coolant():
+    op, df = run("T2 M6\nS1000 M3\nM8\nG1 X1 F100\nM4\nM9\nM5\n")
+    row = df.iloc[3]
+    assert (row.tool, row.spindle, row.coolant) == (2, 1000.0, 2)
+    assert df["spindle"].iloc[4] == -1000.0
+    assert df["coolant"].iloc[-1] == 0 and df["spindle"].iloc[-1] == 0
+
+
+def test_program_end_stops_the_machine():
+    op, df = run("G21 G1 X1 F100\nM2\nG1 X50\n")
+    assert end(op) == (1.0, 0.0, 0.0)
+    assert any("program end" in d.message for d in op.diagnostics)
+
+
+def test_statistics_and_bounds_warn_before_emulation():
+    op = gcodekit.parse_program("G1 X1\n", flavor="rs274ngc")
+    with pytest.warns(UserWarning):
+        assert op.get_bounds() is None
+    with pytest.warns(UserWarning):
+        assert op.get_statistics() is None
+    assert len(op.process_data) == 0
+    gcodekit.emulate(op)
+    assert op.get_bounds()["max"][0] == 1.0
+
+
+def test_bounds_include_arc_bulge():
+    op, _ = run("G21 G0 X10 Y0\nG3 X-10 Y0 I-10 J0 F100\n")
+    assert op.get_bounds("feed")["max"][1] == pytest.approx(10.0)
+
+
+# -- the vectorized runs against a plain per-move reference -----------------------
+
+def reference_positions(lines):
+    """Absolute/incremental linear moves with G20/G21 and G92, one at a time."""
+    pos = np.zeros(3)
+    offset = np.zeros(3)
+    units, incremental = 1.0, False
+    out = []
+    for kind, values in lines:
+        if kind == "G20":
+            units = 25.4
+        elif kind == "G21":
+            units = 1.0
+        elif kind == "G90":
+            incremental = False
+        elif kind == "G91":
+            incremental = True
+        elif kind == "G92":
+            for ax, v in values.items():
+                offset[ax] = pos[ax] - v * units
+        else:
+            for ax, v in values.items():
+                pos[ax] = (pos[ax] + v * units) if incremental else v * units + offset[ax]
+            out.append(pos.copy())
+    return out
+
+
+axis_values = st.dictionaries(st.sampled_from([0, 1, 2]), st.integers(-500, 500).map(lambda v: v / 8),
+                              min_size=1, max_size=3)
+program_lines = st.lists(st.one_of(
+    st.tuples(st.just("G1"), axis_values),
+    st.tuples(st.just("G1"), axis_values),
+    st.tuples(st.sampled_from(["G20", "G21", "G90", "G91"]), st.just({})),
+    st.tuples(st.just("G92"), axis_values),
+), max_size=40)
+
+
+@settings(max_examples=200, deadline=None)
+@given(program_lines)
+def test_vectorized_runs_match_reference(lines):
+    text = "G21 G90 F1000\n" + "".join(
+        f"{kind} " + " ".join(f"{'XYZ'[a]}{v}" for a, v in values.items()) + "\n" for kind, values in lines)
+    op = gcodekit.gcode_to_operation(text, "linuxcnc")
+    moved = op.to_dataframe()
+    moved = moved[moved["kind"].isin(["move"])]
+    expected = reference_positions(lines)
+    got = moved[["x", "y", "z"]].to_numpy()
+    assert got.shape == (len(expected), 3)
+    np.testing.assert_allclose(got, np.array(expected).reshape(-1, 3), atol=1e-9)
