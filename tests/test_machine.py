@@ -231,3 +231,13 @@ def test_vectorized_runs_match_reference(lines):
     got = moved[["x", "y", "z"]].to_numpy()
     assert got.shape == (len(expected), 3)
     np.testing.assert_allclose(got, np.array(expected).reshape(-1, 3), atol=1e-9)
+
+
+def test_g90_g91_set_the_extrusion_mode_in_marlin_not_klipper():
+    text = "M83\nG90\nG1 X1 E1 F600\nG1 X2 E2\nG91\nG1 E-1\nG90\nG1 X3 E1.5\n"
+    _, marlin = run(text, "marlin")
+    _, klipper = run(text, "klipper")
+    # Marlin: G90 made E absolute again (1, then +1), G91 relative (-1), G90 absolute (1.5 - 1)
+    assert marlin["de"].tolist() == pytest.approx([0, 0, 1, 1, 0, -1, 0, 0.5])
+    # Klipper keeps M83 through G90; G91 is relative anyway
+    assert klipper["de"].tolist() == pytest.approx([0, 0, 1, 2, 0, -1, 0, 1.5])

@@ -195,7 +195,7 @@ class Machine:
             return np.zeros(n)
         e = _dense(t.params["E"], rows) * s.units
         e[~moving] = np.nan
-        if s.e_relative:
+        if s.e_relative or s.incremental:
             de = np.nan_to_num(e)
             s.e_program += float(de.sum())
         else:

@@ -75,6 +75,8 @@ class ModalHandler:
         if name in _SIMPLE:
             attr, value = _SIMPLE[name]
             setattr(s, attr, value)
+            if attr == "incremental" and self.machine.config.distance_mode_sets_extrusion:
+                s.e_relative = value
         elif name.startswith("work_offset_"):
             s.work_offset = int(name.rsplit("_", 1)[1])
         elif name == "set_position":

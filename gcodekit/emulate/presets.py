@@ -59,6 +59,9 @@ class MachineConfig:
         choose which axes home to the stored position (printer firmware).
     tool_change_on : {"M6", "T"}
         The word that puts the selected tool in the spindle/extruder.
+    distance_mode_sets_extrusion : bool
+        G90/G91 also switch E to absolute/relative, overriding M82/M83
+        (Marlin, RepRapFirmware).  Everywhere, E is relative under G91.
     block_delete : bool
         The block-delete switch: lines starting with ``/`` are skipped.
     filament_diameter : float
@@ -79,6 +82,7 @@ class MachineConfig:
     dwell_p_unit: str = "s"
     home_mode: str = "stored"
     tool_change_on: str = "M6"
+    distance_mode_sets_extrusion: bool = False
     block_delete: bool = False
     filament_diameter: float = 1.75
     filament_density: float = 1.24
