@@ -71,6 +71,7 @@ class Machine:
         for code, vector in config.work_offsets.items():
             self.state.work_offsets[_WORK_INDEX[code], : len(vector)] = vector
         self.modal = ModalHandler(self)
+        self._straight_ids = np.array([NAME_ID["rapid"], NAME_ID["linear"]], np.uint8)
         self._warned: set[str] = set()
 
     # -- running ----------------------------------------------------------------
@@ -136,6 +137,8 @@ class Machine:
         n = stop - start
         kind = t.kind[rows]
         moving = np.isin(kind, _MOVING)
+        if self.config.empty_moves:
+            moving |= np.isin(t.name[rows], self._straight_ids)
         motion = np.where(moving, t.motion[rows], 0).astype(np.uint8)
         offset = s.offset
         scale = s.scale()

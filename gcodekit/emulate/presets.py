@@ -59,6 +59,9 @@ class MachineConfig:
         choose which axes home to the stored position (printer firmware).
     tool_change_on : {"M6", "T"}
         The word that puts the selected tool in the spindle/extruder.
+    empty_moves : bool
+        A G0/G1 with no axis words still makes a zero-length move (LinuxCNC's
+        interpreter does; firmware only updates the mode and feed).
     distance_mode_sets_extrusion : bool
         G90/G91 also switch E to absolute/relative, overriding M82/M83
         (Marlin, RepRapFirmware).  Everywhere, E is relative under G91.
@@ -82,6 +85,7 @@ class MachineConfig:
     dwell_p_unit: str = "s"
     home_mode: str = "stored"
     tool_change_on: str = "M6"
+    empty_moves: bool = False
     distance_mode_sets_extrusion: bool = False
     block_delete: bool = False
     filament_diameter: float = 1.75
