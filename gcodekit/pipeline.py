@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
 import sys
 from pathlib import Path
 from typing import Iterator
@@ -33,6 +34,7 @@ from .syntax import Flavor, detect_flavor, load_flavor
 
 __all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate", "resolve"]
 
+_O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
 _PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
 
 
@@ -196,7 +198,7 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         from .preprocess import ParameterStage, SourceLine, needs_parameters, run_stages
 
         text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
-        if needs_parameters(text):
+        if needs_parameters(text) or _O_WORD_LINE.search(text):
             lines = text.split("\n")
             if lines and lines[-1] == "":
                 lines.pop()

@@ -299,3 +299,20 @@ def test_substituted_values_read_back_exactly(values):
     words = texts[-1].split()[1:]
     assert [float(w[1:]) for w in words] == [v + 0.0 for v in values]
     assert all(math.isfinite(float(w[1:])) for w in words)
+
+
+def test_program_with_parameters_runs_through_the_pipeline():
+    import gcodekit
+
+    text = "#1 = 10\n#<depth> = -2\nG21 G0 X#1 Y[#1 / 4]\nG1 Z#<depth> F[60 * 2]\nO100 (a Fanuc program number)\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc")
+    assert op.motions()[["x", "y", "z"]].values.tolist() == [[10, 2.5, 0], [10, 2.5, -2]]
+    assert op.motions()["feed"].iloc[1] == 120
+    assert not [d for d in op.diagnostics if d.severity == "error"]
+
+
+def test_o_word_flow_is_reported_even_without_parameters():
+    import gcodekit
+
+    op = gcodekit.gcode_to_operation("o100 sub\nG1 X1 F10\no100 endsub\n", "linuxcnc")
+    assert [d.line for d in op.diagnostics if "O-word" in d.message] == [1, 3]

@@ -46,6 +46,8 @@ O_WORD_MESSAGE = "O-word control flow is not supported yet (issue #4)"
 # (LinuxCNC ``read_items``); a '(' or ';' ends the match, so commented
 # O-words are not seen.
 _O_WORD = re.compile(r"[ \t]*(?:/[ \t]*)?(?:[nN][0-9. \t]*)?([oO])")
+#: ``O1234`` alone (a comment may follow) names a Fanuc-style program: no flow.
+_PROGRAM_NUMBER = re.compile(r"[ \t]*[oO][0-9]+[ \t]*(\(.*\))?[ \t]*$")
 _SPACE = " \t\r\n\v\f"
 
 # (start, end, replacement) in the line's text, in order; and (key, value).
@@ -229,6 +231,9 @@ class ParameterStage:
 
     def _line(self, line: SourceLine, diagnostics: Diagnostics) -> SourceLine:
         text = line.text
+        number = _PROGRAM_NUMBER.match(text)
+        if number:
+            return dataclasses.replace(line, text=number.group(1) or "")
         o_word = _O_WORD.match(text)
         if o_word:
             diagnostics.report(line.line, o_word.start(1) + 1, O_WORD_MESSAGE, text, kind="syntax")
