@@ -241,3 +241,10 @@ def test_g90_g91_set_the_extrusion_mode_in_marlin_not_klipper():
     assert marlin["de"].tolist() == pytest.approx([0, 0, 1, 1, 0, -1, 0, 0.5])
     # Klipper keeps M83 through G90; G91 is relative anyway
     assert klipper["de"].tolist() == pytest.approx([0, 0, 1, 2, 0, -1, 0, 1.5])
+
+
+def test_feed_per_revolution():
+    # 0.1 mm per revolution at 600 rpm is 60 mm/min: 30 mm take 30 s
+    _, df = run("G21 S600 M3\nG95 G1 X30 F0.1\n")
+    assert df["time"].iloc[-1] == pytest.approx(30.0)
+    assert df["feed"].iloc[-1] == pytest.approx(60.0)

@@ -172,6 +172,9 @@ class Machine:
         if is_arc.any():
             self._arcs(t, start, np.flatnonzero(is_arc), start_pos, position, centers, distance, offset, scale)
         rotary = np.sqrt(np.einsum("ij,ij->i", delta[:, 3:], delta[:, 3:]))
+        speed = self._spindle_speeds(t, rows, kind)
+        if s.feed_mode == "per_rev":  # G95: F is mm per spindle revolution
+            feed = feed * np.abs(speed) * (s.spindle != 0)
         time = self._durations(t, rows, kind, motion, distance, rotary, de, feed)
 
         for ax, letter in enumerate(AXES.lower()):
@@ -182,13 +185,14 @@ class Machine:
         out["time"][rows] = time
         out["motion"][rows] = motion
         out["cx"][rows], out["cy"][rows], out["cz"][rows] = centers.T
-        speed = self._spindle_speeds(t, rows, kind)
         out["spindle"][rows] = speed * s.spindle
         self._fill_state(rows, out)
 
         s.position = position[-1].copy()
-        if s.feed_mode != "inverse_time":
+        if s.feed_mode == "per_minute":
             s.feed = float(feed[-1])
+        elif s.feed_mode == "per_rev":
+            s.feed = float(_forward_fill(feed_words, s.feed)[-1])
         s.speed = float(speed[-1])
 
     def _extrusion(self, t: CommandTable, rows: slice, moving: np.ndarray) -> np.ndarray:
