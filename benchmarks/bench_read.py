@@ -8,8 +8,9 @@ same file, with a peak memory of at most 300 bytes per input line.
 Each run is a fresh interpreter, so its peak resident set size is its own; the
 two libraries run alternately and the best time of each counts. Both timings
 include reading and decompressing the file; neither includes the import, which
-is reported on its own for gcodekit. The exit status is 0 when every check
-passes, 1 when one fails and 2 when gcodeparser is missing.
+is reported on its own for gcodekit. The checks bind only on the acceptance
+file: the exit status is 1 when one of them fails there, 2 when gcodeparser is
+missing, else 0.
 
 Examples
 --------
@@ -134,7 +135,8 @@ def report(result: dict) -> str:
         rows.append(f"{tool:12} {t['runs']:4d} {t['seconds']:8.2f} {t['peak_mb']:8.1f} "
                     f"{t['above_import_mb']:16.1f} {t['bytes_per_line']:7.0f} "
                     f"{t['bytes_per_line_above_import']:20.0f} {t['items']:10,}")
-    rows.append("")
+    rows.append("" if result["acceptance"] else
+                f"\n(informative: the acceptance figures are defined on {FULL_FILE.name})")
     for name, check in c.items():
         rows.append(f"{name:42} {check['value']:8.2f} <= {check['limit']:<4} "
                     f"{'PASS' if check['pass'] else 'FAIL'}")
@@ -179,6 +181,7 @@ def main(argv: list[str] | None = None) -> int:
     }
     result = {
         "date": datetime.date.today().isoformat(), "file": path.name, "lines": lines,
+        "acceptance": path.resolve() == FULL_FILE,
         "python": platform.python_version(), "cpus": os.cpu_count(),
         "versions": {tool: importlib.metadata.version(tool) for tool in TOOLS},
         "runs": runs, "summary": summary,
@@ -187,7 +190,8 @@ def main(argv: list[str] | None = None) -> int:
     print(report(result))
     if args.json:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
-    return 0 if all(c["pass"] for c in result["checks"].values()) else 1
+    failed = not all(c["pass"] for c in result["checks"].values())
+    return 1 if result["acceptance"] and failed else 0
 
 
 if __name__ == "__main__":
