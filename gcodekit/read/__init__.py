@@ -32,7 +32,7 @@ __all__ = ["Block", "Blocks", "Word", "read_text", "read_file", "iter_blocks", "
            "open_program", "read_source_lines", "MAX_LINE_LENGTH"]
 
 Source = Union[str, os.PathLike, bytes]
-CHUNK_BYTES = 4 << 20
+CHUNK_BYTES = 256 << 10  # small chunks keep the per-chunk arrays (about 60 bytes per input byte) small
 #: Longer lines are reported and skipped: no real controller accepts them,
 #: and a binary file without newlines must not be read as one huge block.
 MAX_LINE_LENGTH = 65536
