@@ -248,3 +248,17 @@ def test_feed_per_revolution():
     _, df = run("G21 S600 M3\nG95 G1 X30 F0.1\n")
     assert df["time"].iloc[-1] == pytest.approx(30.0)
     assert df["feed"].iloc[-1] == pytest.approx(60.0)
+
+
+def test_ger_relaxed_statements():
+    """GER manual, section 2: several statements per line, ';' separates them."""
+    text = "(a comment\nover two lines) G21\nG01 X1.0 G20 G01 Y1.0 F10\nG01 X2.0; Y2.0\nX3 Y3\n"
+    op = gcodekit.gcode_to_operation(text, "ger")
+    m = op.motions()
+    # lengths are given in the units in force at each move: X1 mm is 1/25.4 in after G20
+    expected = [[1.0, 0.0], [1 / 25.4, 1.0], [2.0, 1.0], [2.0, 2.0], [3.0, 3.0]]
+    np.testing.assert_allclose(m[["x", "y"]].to_numpy(), expected)
+    assert m["units"].tolist() == ["mm", "in", "in", "in", "in"]
+    assert op.commands[0].comment == "a comment over two lines"
+    # the program starts in rapid mode: axis words alone move at once
+    assert gcodekit.gcode_to_operation("X1 Y1\n", "ger").motions()["motion"].tolist() == ["rapid"]

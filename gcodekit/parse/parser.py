@@ -46,9 +46,10 @@ class GcodeParser:
     def __init__(self, flavor: Flavor | str, diagnostics: Diagnostics | None = None):
         self.flavor = load_flavor(flavor) if isinstance(flavor, str) else flavor
         self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
-        self.motion = MOTION_NONE
+        self.motion = MOTION_OF_NAME.get(self.flavor.initial_motion, MOTION_NONE)
         self._n_letter = ord(self.flavor.line_number_letter) if self.flavor.line_number_letter else -1
         self._modal = self.flavor.block_split == "modal"
+        self._modal_motion = self.flavor.block_split != "single"  # firmware needs a code on every move
         self._name_cache: dict[int, int] = {}
         self._unknown_reported: set[str] = set()
 
@@ -67,9 +68,9 @@ class GcodeParser:
         compound = n_codes >= 2
         if blocks.extras:
             compound[list(blocks.extras)] = True
-        if self._modal:
+        if self._modal_motion:
             compound |= self._axis_words_on_non_consumer(blocks, is_code, is_param, n_codes)
-        elif self.flavor.block_split == "sequential":
+        if self.flavor.block_split == "sequential":
             compound |= has_param & (n_codes == 1) & self._params_before_code(wb, is_code, n_blocks)
         simple = ~compound & ((n_codes == 1) | has_param | has_comment)
 
@@ -272,7 +273,7 @@ class GcodeParser:
         arc = (motion == 3) | (motion == 4)
         has_axes |= arc & has("IJKR")  # "G2 I5" is a full circle from where the tool is
         is_motion_name = np.isin(name, [NAME_ID[m] for m in MOTION_OF_NAME])
-        implicit = (letter == 0) & has_axes if self._modal else np.zeros(n, bool)
+        implicit = (letter == 0) & has_axes if self._modal_motion else np.zeros(n, bool)
         moving = (is_motion_name | implicit) & (has_axes | has_e)
 
         kind = np.full(n, Kind.CONFIG, np.uint8)
@@ -302,7 +303,7 @@ class GcodeParser:
         for i in np.flatnonzero(lost)[:100].tolist():
             self.diagnostics.report(int(t["line"][i]), 1, "axis words but no motion mode (G0/G1/G2/G3) is in force")
         kind[lost] = Kind.CONFIG
-        orphan = (letter == 0) & (has_axes | has_e) & (not self._modal)
+        orphan = (letter == 0) & (has_axes | has_e) & (not self._modal_motion)
         for i in np.flatnonzero(orphan)[:100].tolist():
             self.diagnostics.warn(int(t["line"][i]), 1, "words without a command are ignored by this firmware")
         kind[orphan] = Kind.CONFIG

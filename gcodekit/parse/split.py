@@ -78,7 +78,7 @@ def split_block(words: list[tuple[str, float]], flavor: Flavor, line_number_lett
     if flavor.block_split == "single":
         return _split_single(words)
     if flavor.block_split == "sequential":
-        return _split_sequential(words), []
+        return _split_sequential(words, flavor), []
     return _split_modal(words, flavor)
 
 
@@ -101,14 +101,20 @@ def _split_single(words):
     return [part], problems
 
 
-def _split_sequential(words):
+def _split_sequential(words, flavor):
+    """GER: each code starts a statement; axis words after a code that takes
+    none (``G20 X1``) are a modal move of their own."""
     parts: list[Part] = []
     current = Part("")
+
+    def takes_axes(part: Part) -> bool:
+        return not part.letter or code_name(flavor, part.letter, part.number) in AXIS_CONSUMERS
+
     for letter, value in words:
-        if letter in "GM":
+        if letter in "GM" or (letter in AXIS_LETTERS and not takes_axes(current)) or letter in current.params:
             if current.letter or current.params:
                 parts.append(current)
-            current = Part(letter, value)
+            current = Part(letter, value) if letter in "GM" else Part("", params={letter: value})
         else:
             current.params[letter] = value
     if current.letter or current.params:

@@ -138,6 +138,9 @@ class Flavor:
         E mode at program start; ``""`` when the dialect does not extrude.
     rapid_is_feed : bool
         G0 moves at the programmed feed (Marlin), not at the rapid rate.
+    initial_motion : {"", "rapid", "linear"}
+        Motion mode in force at program start (GER starts in G0), so axis
+        words alone move; ``""`` when they need a motion code first.
     layer_comments : tuple of str
         Regular expressions on comment text marking a new layer.
     feature_comment : str
@@ -169,6 +172,7 @@ class Flavor:
     units: str = "mm"
     extrusion: str = ""
     rapid_is_feed: bool = False
+    initial_motion: str = ""
     layer_comments: tuple[str, ...] = ()
     feature_comment: str = ""
     detect: DetectRules = DetectRules()

@@ -39,6 +39,7 @@ _CHOICES = {
     "units": ("mm", "inch"),
     "extrusion": ("absolute", "relative", ""),
     "comment": (";", "(", ""),
+    "initial_motion": ("", "rapid", "linear"),
 }
 
 
