@@ -27,6 +27,7 @@ import pandas as pd
 from ..errors import Diagnostics
 from ..parse.commands import Command, Kind
 from ..parse.table import MOTION_NAMES, NAMES, CommandTable
+from ..syntax.flavor import code_label
 from .machine import FLOAT_COLUMNS, SMALL_COLUMNS
 from .state import MM_PER_INCH
 
@@ -285,7 +286,7 @@ class Operation:
             if letter in (0, ord("@")):
                 labels.append("")
             else:
-                labels.append(chr(letter) + (str(number // 10) if number % 10 == 0 else f"{number // 10}.{number % 10}"))
+                labels.append(code_label(chr(letter), number))
         codes = np.array(labels, dtype=object)[inverse]
         for row, (name, _) in t.named.items():
             codes[row] = name

@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import Diagnostics
 from ..read import Blocks
 from ..syntax import Flavor, load_flavor
+from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
 from .table import MOTION_NONE, MOTION_OF_NAME, NAME_ID, CommandTable
@@ -313,7 +314,7 @@ class GcodeParser:
         letter, number = t["letter"], t["number"]
         unknown = np.flatnonzero((name == 0) & ((letter == _G) | (letter == _M)))
         for i in unknown.tolist():
-            code = chr(letter[i]) + (str(number[i] // 10) if number[i] % 10 == 0 else f"{number[i] / 10:g}")
+            code = code_label(chr(letter[i]), int(number[i]))
             if code in self._unknown_reported:
                 continue
             self._unknown_reported.add(code)

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..syntax import Flavor
+from ..syntax.flavor import code_label
 
 AXIS_LETTERS = frozenset("XYZABCUVW")
 #: Commands that take axis words in the same block.
@@ -67,9 +68,8 @@ class Part:
 
 
 def code_name(flavor: Flavor, letter: str, number: float) -> str:
-    tenths = round(number * 10)
-    text = str(tenths // 10) if tenths % 10 == 0 else f"{tenths // 10}.{tenths % 10}"
-    return flavor.codes.get(f"{letter}{text}", "")
+    """Normalized name of a code given by letter and value, ``""`` if unknown."""
+    return flavor.codes.get(code_label(letter, round(number * 10)), "")
 
 
 def split_block(words: list[tuple[str, float]], flavor: Flavor, line_number_letter: str) -> tuple[list[Part], list[str]]:

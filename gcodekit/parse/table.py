@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..syntax.flavor import COMMANDS
+from ..syntax.flavor import COMMANDS, code_label
 from .commands import COMMAND_CLASSES, Command, Kind
 
 #: Normalized command names by id; id 0 is "" (no code or unknown code).
@@ -108,7 +108,7 @@ class CommandTable:
             return self.named[i][0]
         if letter == 0:
             return ""
-        return chr(letter) + (str(number // 10) if number % 10 == 0 else f"{number // 10}.{number % 10}")
+        return code_label(chr(letter), number)
 
     def comment_of(self, i: int) -> str | None:
         """Comment text of row ``i`` (several comments joined by a space), or None."""

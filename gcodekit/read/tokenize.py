@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 from ..errors import Diagnostics
 from ..syntax import Flavor
+from ..syntax.flavor import code_label
 
 _DIGITS = "0123456789"
 _SPACE = " \t\r\f\v"
@@ -203,7 +204,7 @@ class LineTokenizer:
             except ValueError:
                 self.diagnostics.report(block.line, j + 1, "'=' must be followed by a number", text)
             return k
-        code = f"{letter}{_code_text(float(number))}"
+        code = code_label(letter, round(value * 10))
         if code in fl.string_codes and letter in "GM":
             rest = text[j:]
             cut = min((p for p in (rest.find(c) for c in fl.line_comments) if p >= 0), default=-1)
@@ -263,9 +264,3 @@ class LineTokenizer:
         while j < len(text) and not (text[j].isalpha() or text[j] in _SPACE or text[j] in self.flavor.line_comments or text[j] == "("):
             j += 1
         return j
-
-
-def _code_text(value: float) -> str:
-    """``92.1`` -> ``"92.1"``, ``1.0`` -> ``"1"``: how codes are keyed in flavors."""
-    tenths = round(value * 10)
-    return str(tenths // 10) if tenths % 10 == 0 else f"{tenths // 10}.{tenths % 10}"

@@ -54,6 +54,15 @@ PARAMETERS = frozenset(
 )
 
 
+def code_label(letter: str, tenths: int) -> str:
+    """How codes are written in flavor files: ``("G", 921)`` -> ``"G92.1"``, ``("G", 10)`` -> ``"G1"``.
+
+    Code numbers are carried as integers in tenths, so ``G92.1`` stays exact.
+    """
+    whole, tenth = divmod(int(tenths), 10)
+    return f"{letter}{whole}" if tenth == 0 else f"{letter}{whole}.{tenth}"
+
+
 @dataclass(frozen=True)
 class DetectRules:
     """Evidence that a program is written in this flavor.
