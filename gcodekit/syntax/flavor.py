@@ -196,3 +196,6 @@ class Flavor:
 
     def __repr__(self) -> str:
         return f"Flavor({self.name!r})"
+
+    def __hash__(self) -> int:  # the mapping fields are not hashable; names are unique
+        return hash(self.name)
