@@ -127,7 +127,8 @@ def emulate(operation: Operation, machine: str | MachineConfig | None = None) ->
 
 def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig | None = None, *,
                        flavor: str | Flavor | None = None, mode: str = "lenient",
-                       progress: bool = False, **machine_options) -> Operation:
+                       progress: bool = False, machine_config: str | os.PathLike | None = None,
+                       plan: bool = True, **machine_options) -> Operation:
     """Read, parse and emulate a program into an :class:`Operation`.
 
     Parameters
@@ -143,6 +144,11 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         strict raises the first as a :class:`~gcodekit.errors.GcodeError`.
     progress : bool, default: False
         Show a progress bar on standard error.
+    machine_config : path, optional
+        The firmware's own configuration (Klipper ``printer.cfg``) for the
+        machine's planner; its values replace the preset's.
+    plan : bool, default: True
+        Time the moves with the machine's motion planner, if it has one.
     **machine_options
         Override preset values (``rapid_feed=5000``).
 
@@ -179,6 +185,10 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         waypoints, sizes = [m.run(table)], [0]
     op = cls(table, _concat_waypoints(waypoints, sizes), file=program.name,
              flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
+    if plan and config.planner:
+        from .emulate.planners import planner_settings, run_planner
+
+        run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
     quote_diagnostics(op.diagnostics, program)
     return op
 

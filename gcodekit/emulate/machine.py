@@ -297,7 +297,8 @@ class Machine:
         p = _dense(t.params["P"], rows)[dwell] if "P" in t.params else np.full(int(dwell.sum()), np.nan)
         s_word = _dense(t.params["S"], rows)[dwell] if "S" in t.params else np.full(p.size, np.nan)
         unit = 0.001 if self.config.dwell_p_unit == "ms" else 1.0
-        return np.where(~np.isnan(p), p * unit, np.nan_to_num(s_word))
+        seconds = np.nan_to_num(s_word) if self.config.dwell_s_seconds else np.zeros(p.size)
+        return np.where(~np.isnan(p), p * unit, seconds)
 
     def _once(self, key: str, line: int, message: str) -> None:
         if key not in self._warned:

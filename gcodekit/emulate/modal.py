@@ -9,6 +9,7 @@ and program end.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -27,7 +28,7 @@ SPECIAL_NAMES = frozenset(
     restore_position_offset home home_secondary store_home store_home_secondary
     extrude_absolute extrude_relative set_flow tool_change spindle_cw spindle_ccw spindle_off
     coolant_mist coolant_flood coolant_off program_end machine_coordinates
-    firmware_retract firmware_unretract""".split()
+    firmware_retract firmware_unretract set_kinematic_position""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)}
 
 _SIMPLE = {
@@ -108,6 +109,8 @@ class ModalHandler:
             s.coolant = {"coolant_mist": s.coolant | 1, "coolant_flood": s.coolant | 2, "coolant_off": 0}[name]
         elif name == "program_end":
             self._end_program()
+        elif name == "set_kinematic_position":
+            self._set_kinematic_position(t.command(row).text)
         for w in extra:
             self._fill_passing(w, before)
             before = np.array([w.values[k] for k in AXES.lower()])
@@ -173,6 +176,12 @@ class ModalHandler:
             s.selected_tool = number
         else:
             s.tool = int(params.get("T", s.selected_tool))
+
+    def _set_kinematic_position(self, text: str) -> None:
+        """Klipper's SET_KINEMATIC_POSITION X=.. Y=.. Z=..: the toolhead is declared there."""
+        s = self.state
+        for key, value in re.findall(r"\b([XYZ])\s*=\s*([-+]?[0-9.]+)", text.upper()):
+            s.position["XYZ".index(key)] = float(value)
 
     def _end_program(self) -> None:
         """M2/M30: LinuxCNC resets these modes and stops reading the program."""

@@ -73,6 +73,14 @@ class MachineConfig:
         g/cm^3; turns volume into mass.
     work_offsets : mapping of str to list of float
         Initial G54-G59.3 offsets in mm, e.g. ``G55 = [100, 0, 0]``.
+    dwell_s_seconds : bool
+        ``G4 S`` is a dwell in seconds (Marlin, RepRapFirmware); Klipper
+        ignores S.
+    planner : str
+        Motion planner that times the moves (``"klipper"``); ``""`` keeps
+        time as length over feed.
+    planner_settings : mapping
+        The planner's settings (the ``[planner]`` table), e.g. ``max_accel``.
     """
 
     name: str
@@ -91,6 +99,9 @@ class MachineConfig:
     filament_diameter: float = 1.75
     filament_density: float = 1.24
     work_offsets: Mapping[str, tuple[float, ...]] = field(default_factory=lambda: MappingProxyType({}))
+    dwell_s_seconds: bool = True
+    planner: str = ""
+    planner_settings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
 
     def __hash__(self) -> int:
         return hash(self.name)
@@ -128,6 +139,10 @@ def _load(path: Path) -> MachineConfig:
             data = tomllib.load(f)
     except (OSError, tomllib.TOMLDecodeError) as exc:
         raise ConfigError(f"{path}: cannot read machine preset: {exc}") from exc
+    if isinstance(data.get("planner"), dict):  # a [planner] table: its name is given by `name`
+        table = dict(data.pop("planner"))
+        data["planner"] = table.pop("name", "")
+        data["planner_settings"] = table
     return _build(data, path)
 
 
@@ -150,7 +165,8 @@ def _build(data: dict, path: Path) -> MachineConfig:
             raise ConfigError(f"{path}: [work_offsets] {code} must be one of G54..G59.3 with up to 6 values"
                               + did_you_mean(code, _WORK_OFFSET_CODES))
         offsets[code] = tuple(float(v) for v in vector)
-    data = {**data, "work_offsets": MappingProxyType(offsets)}
+    data = {**data, "work_offsets": MappingProxyType(offsets),
+            "planner_settings": MappingProxyType(dict(data.get("planner_settings", data.pop("planner_table", {}))))}
     if "name" not in data:
         data["name"] = path.stem
     return MachineConfig(**data)

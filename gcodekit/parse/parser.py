@@ -247,6 +247,9 @@ class GcodeParser:
         n = letter.size
         name = self._name_ids(letter, number, tenths=True)
         name[(letter == _T) | (letter == _NAMED)] = 0
+        for i, part in t.get("parts_by_row", {}).items():
+            if part.named is not None:  # Klipper's extended commands are named in [codes] too
+                name[i] = NAME_ID.get(self.flavor.codes.get(part.named[0].upper(), ""), 0)
         self._report_unknown(t, name)
 
         sets = np.full(n, _KEEP, np.uint8)

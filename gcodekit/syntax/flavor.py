@@ -42,7 +42,7 @@ COMMANDS = frozenset(
     set_hotend_temp wait_hotend_temp set_bed_temp wait_bed_temp set_chamber_temp
     fan_on fan_off
     set_max_accel set_max_feed set_accel set_jerk set_junction_deviation wait_moves
-    mesh_level motors_off message progress
+    mesh_level motors_off message progress set_kinematic_position
     weld_start laser_on laser_off
     probe
     """.split()

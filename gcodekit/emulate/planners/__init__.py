@@ -1,0 +1,82 @@
+"""Emulate stage, planning: firmware motion planners, chosen by name.
+
+A machine preset names its planner (``planner = "klipper"``); each planner
+module has a settings class built from the preset's ``[planner]`` table or
+from the firmware's own configuration file, and a ``plan(op, settings)``
+function returning the firmware's moves and their planned velocities.
+:func:`apply_plan` sums the moves back onto the operation's waypoints.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import os
+from typing import TYPE_CHECKING, Any, Mapping
+
+import numpy as np
+
+from ...errors import ConfigError, did_you_mean
+from .base import PlannerMoves, PlanResult
+
+if TYPE_CHECKING:
+    from ..operation import Operation
+
+#: Planner name -> (module, settings class, reader of the firmware's own config file)
+PLANNERS = {
+    "klipper": ("gcodekit.emulate.planners.klipper", "KlipperConfig", "from_printer_cfg"),
+}
+
+
+def planner_settings(name: str, preset: Mapping[str, Any], config_file: str | os.PathLike | None = None):
+    """Settings for planner ``name``: its defaults, the preset's values, then the firmware file."""
+    if name not in PLANNERS:
+        raise ConfigError(f"unknown planner {name!r}; choose one of {', '.join(PLANNERS)}" + did_you_mean(name, PLANNERS))
+    module_name, class_name, reader = PLANNERS[name]
+    cls = getattr(importlib.import_module(module_name), class_name)
+    if config_file is not None:
+        settings = getattr(cls, reader)(config_file)
+    else:
+        settings = cls()
+    known = {f.name for f in dataclasses.fields(cls)}
+    for key in preset:
+        if key not in known:
+            raise ConfigError(f"planner {name!r} has no setting {key!r}" + did_you_mean(key, known))
+    if config_file is None and preset:
+        settings = dataclasses.replace(settings, **dict(preset))
+    return settings
+
+
+def run_planner(op: "Operation", name: str, settings) -> "Operation":
+    """Plan ``op`` with planner ``name`` and write the planned times into it."""
+    module = importlib.import_module(PLANNERS[name][0])
+    moves, result = module.plan(op, settings)
+    apply_plan(op, moves, result)
+    return op
+
+
+def apply_plan(op: "Operation", moves: PlannerMoves, result: PlanResult) -> None:
+    """Per-waypoint planned time and speeds from per-move results.
+
+    A waypoint's ``time`` becomes the sum of its moves' durations (dwells
+    keep theirs); ``start_v`` is its first move's entry speed, ``end_v`` its
+    last move's exit speed, ``cruise_v`` the fastest cruise among its moves.
+    """
+    w = op.waypoints
+    n = w["x"].size
+    planned = np.bincount(moves.waypoint, weights=result.duration_t, minlength=n)
+    has_moves = np.bincount(moves.waypoint, minlength=n) > 0
+    w["time"] = np.where(has_moves, planned, np.where(w["motion"] > 0, 0.0, w["time"]))
+    start_v = np.zeros(n)
+    end_v = np.zeros(n)
+    cruise_v = np.zeros(n)
+    accel = np.zeros(n)
+    first = np.r_[True, moves.waypoint[1:] != moves.waypoint[:-1]]
+    last = np.r_[moves.waypoint[1:] != moves.waypoint[:-1], True]
+    start_v[moves.waypoint[first]] = result.start_v[first]
+    end_v[moves.waypoint[last]] = result.end_v[last]
+    np.maximum.at(cruise_v, moves.waypoint, result.cruise_v)
+    accel[moves.waypoint[first]] = result.accel[first]
+    w.update(start_v=start_v, cruise_v=cruise_v, end_v=end_v, accel=accel)
+    op.plan = (moves, result)
+    op._elapsed = None

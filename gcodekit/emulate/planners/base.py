@@ -1,0 +1,189 @@
+"""Emulate stage, planning: the moves a firmware plans, and what it planned.
+
+A firmware does not plan G-code lines; it plans *moves*: straight segments
+of the toolhead (arcs cut into chords by the firmware's own rule) and
+extruder-only moves.  :func:`firmware_moves` turns an emulated operation's
+waypoints into those moves, each remembering the command row and waypoint
+it came from, so a plan can be summed back onto the program.
+
+Names follow Klipper's suffixes: ``_d`` mm, ``_v`` mm/s, ``_v2`` mm^2/s^2,
+``_t`` s, ``_r`` ratio.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
+
+from ...parse.table import NAME_ID
+from .. import arcs
+
+if TYPE_CHECKING:
+    from ..operation import Operation
+
+#: Chords of an arc: given the arc length in mm, how many segments.
+ArcRule = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass
+class PlannerMoves:
+    """Straight moves in the order the firmware receives them.
+
+    Attributes
+    ----------
+    start, end : ndarray, shape (n, 4)
+        X, Y, Z and extruder position (mm) at both ends.
+    speed_v : ndarray, shape (n,)
+        Requested speed (mm/s): the feed rate over 60 times the speed factor.
+    row : ndarray of int64
+        Command row each move comes from.
+    waypoint : ndarray of int64
+        Waypoint each move belongs to (several for a segmented arc).
+    """
+
+    start: np.ndarray
+    end: np.ndarray
+    speed_v: np.ndarray
+    row: np.ndarray
+    waypoint: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.row.size)
+
+    @property
+    def axes_d(self) -> np.ndarray:
+        return self.end - self.start
+
+    def select(self, keep: np.ndarray) -> "PlannerMoves":
+        return PlannerMoves(self.start[keep], self.end[keep], self.speed_v[keep], self.row[keep], self.waypoint[keep])
+
+
+@dataclass
+class PlanResult:
+    """Per move: the planned velocities, acceleration and phase durations."""
+
+    start_v: np.ndarray
+    cruise_v: np.ndarray
+    end_v: np.ndarray
+    accel: np.ndarray
+    accel_t: np.ndarray
+    cruise_t: np.ndarray
+    decel_t: np.ndarray
+
+    @property
+    def duration_t(self) -> np.ndarray:
+        return self.accel_t + self.cruise_t + self.decel_t
+
+
+def command_rows(op: "Operation", *, names: tuple[str, ...] = (), codes: tuple[str, ...] = ()) -> np.ndarray:
+    """Rows of the commands with these normalized names or literal codes (``"M204"``, named commands)."""
+    t = op.table
+    mask = np.zeros(len(t), bool)
+    ids = [NAME_ID[n] for n in names if n in NAME_ID]
+    if ids:
+        mask |= np.isin(t.name, ids)
+    if codes:
+        labels = op._codes()
+        mask |= np.isin(labels, list(codes))
+    return np.flatnonzero(mask)
+
+
+def in_force(moves: PlannerMoves, rows: np.ndarray, values: np.ndarray, initial: float) -> np.ndarray:
+    """Per move, the last value set by a command row before the move's row."""
+    if rows.size == 0:
+        return np.full(len(moves), initial, dtype=float)
+    k = np.searchsorted(rows, moves.row, side="left") - 1
+    return np.where(k >= 0, np.asarray(values, float)[np.maximum(k, 0)], initial)
+
+
+def happens_before(moves: PlannerMoves, rows: np.ndarray) -> np.ndarray:
+    """Per move: does one of ``rows`` come between the previous move and this one?"""
+    if rows.size == 0 or len(moves) == 0:
+        return np.zeros(len(moves), bool)
+    previous = np.r_[-1, moves.row[:-1]]
+    same_row = previous == moves.row  # chords of one arc have nothing between them
+    count_before = np.searchsorted(rows, moves.row, side="left") - np.searchsorted(rows, previous, side="right")
+    return (count_before > 0) & ~same_row
+
+
+def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
+                   arc_segments: ArcRule | None = None) -> PlannerMoves:
+    """The straight moves of an emulated operation, arcs cut by ``arc_segments``.
+
+    Parameters
+    ----------
+    op : Operation
+        Emulated (``op.waypoints`` present).
+    speed_factor : ndarray, optional
+        Per waypoint multiplier of the feed (M220), 1 when None.
+    arc_segments : callable, optional
+        Segment count from arc length; None keeps each arc as one move
+        along its chord (only for machines that do not segment).
+    """
+    w = op.waypoints
+    n = w["x"].size
+    position = np.column_stack([w["x"], w["y"], w["z"], np.cumsum(w["de"])])
+    previous = np.vstack([np.zeros((1, 4)), position[:-1]])
+    rows = w["command"] if "command" in w else np.arange(n)
+    # Homing moves go to an endstop from wherever the axis really is: their
+    # length and time are unknown, and firmware time estimates leave them out.
+    homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
+    moving = (w["motion"] > 0) & np.any(position != previous, axis=1) & ~homing
+    speed = np.asarray(w["feed"], float) / 60.0
+    if speed_factor is not None:
+        speed = speed * speed_factor
+    idx = np.flatnonzero(moving)
+    is_arc = w["motion"][idx] >= 3
+    if arc_segments is None or not is_arc.any():
+        return PlannerMoves(previous[idx], position[idx], speed[idx], rows[idx], idx)
+    return _with_segmented_arcs(w, idx, is_arc, previous, position, speed, rows, arc_segments)
+
+
+def _with_segmented_arcs(w, idx, is_arc, previous, position, speed, rows, arc_segments) -> PlannerMoves:
+    """Replace each arc waypoint by its chords (Klipper's and Marlin's plan_arc)."""
+    counts = np.ones(idx.size, np.int64)
+    arc_idx = idx[is_arc]
+    centers = np.column_stack([w["cx"], w["cy"], w["cz"]])[arc_idx]
+    planes = np.asarray(w["plane"])[arc_idx]
+    start = previous[arc_idx]
+    end = position[arc_idx]
+    cw = np.asarray(w["motion"])[arc_idx] == 3
+    angle = np.zeros(arc_idx.size)
+    radius = np.zeros(arc_idx.size)
+    axes = np.zeros((arc_idx.size, 3), np.int64)
+    for plane in (17, 18, 19):
+        sel = planes == plane
+        if not sel.any():
+            continue
+        (f, g, h), _ = arcs.PLANES[plane]
+        axes[sel] = (f, g, h)
+        s2, e2, c2 = start[sel][:, [f, g]], end[sel][:, [f, g]], centers[sel][:, [f, g]]
+        angle[sel] = arcs.sweep(s2, e2, c2, cw[sel], np.ones(int(sel.sum())))
+        radius[sel] = np.hypot(*(s2 - c2).T)
+    rise = end[np.arange(arc_idx.size), axes[:, 2]] - start[np.arange(arc_idx.size), axes[:, 2]]
+    travel = np.hypot(radius * angle, rise)
+    counts[is_arc] = np.maximum(arc_segments(travel).astype(np.int64), 1)
+
+    total = int(counts.sum())
+    owner = np.repeat(np.arange(idx.size), counts)
+    step = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts) + 1  # 1..k within a move
+    frac = step / counts[owner]
+    end_all = previous[idx][owner] + (position[idx] - previous[idx])[owner] * frac[:, None]
+    arc_pos = np.flatnonzero(is_arc)
+    which = np.full(idx.size, -1)
+    which[arc_pos] = np.arange(arc_pos.size)
+    arc_owner = which[owner]
+    sel = (arc_owner >= 0) & (step < counts[owner])  # inner chord ends; the last one is exact
+    k = arc_owner[sel]
+    sign = np.where(cw[k], -1.0, 1.0)
+    theta = sign * angle[k] * frac[sel]
+    a0 = np.arctan2(start[k, axes[k, 1]] - centers[k, axes[k, 1]], start[k, axes[k, 0]] - centers[k, axes[k, 0]])
+    rows_sel = np.flatnonzero(sel)
+    end_all[rows_sel, axes[k, 0]] = centers[k, axes[k, 0]] + radius[k] * np.cos(a0 + theta)
+    end_all[rows_sel, axes[k, 1]] = centers[k, axes[k, 1]] + radius[k] * np.sin(a0 + theta)
+    start_all = np.vstack([previous[idx][:1], end_all[:-1]])
+    first = np.cumsum(counts) - counts
+    start_all[first] = previous[idx]
+    return PlannerMoves(start_all, end_all, speed[idx][owner], rows[idx][owner], idx[owner])

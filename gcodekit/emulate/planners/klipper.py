@@ -1,0 +1,305 @@
+"""Emulate stage, planning: Klipper's lookahead, as array code.
+
+Mirrors klippy's ``toolhead.py`` (Move, LookAheadQueue.flush; Klipper
+v0.12+, with ``minimum_cruise_ratio``), ``kinematics/cartesian.py`` (Z
+limits), ``kinematics/extruder.py`` (extrude-only limits and the
+instantaneous corner velocity) and ``extras/gcode_arcs.py`` (arcs cut into
+chords of at most ``resolution`` mm).  Klipper's variable names are kept.
+
+Klipper comes to rest (flushes its lookahead) at G4, M400, G28, M84,
+SET_KINEMATIC_POSITION and the end of the program; everything else, M204
+and SET_VELOCITY_LIMIT included, only changes the moves that follow.
+"""
+
+from __future__ import annotations
+
+import configparser
+import math
+import os
+import re
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ...errors import ConfigError
+from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
+from .scans import backward_min, forward_min, next_marked, segmented_cummin
+
+if TYPE_CHECKING:
+    from ..operation import Operation
+
+EXTRUDE_ONLY_ACCEL = 99999999.9  # klippy: "self.accel = 99999999.9" for extrude-only moves
+NO_LIMIT_V2 = 999999999.9  # klippy's next_junction_v2 default
+TIE = 1e-9  # relative: squared speeds this close count as equal (see flush)
+
+
+@dataclass(frozen=True)
+class KlipperConfig:
+    """The ``[printer]``, ``[extruder]`` and ``[gcode_arcs]`` options the planner reads.
+
+    Units: mm/s, mm/s^2, mm; ratios 0..1.  Defaults are Klipper's.
+    """
+
+    max_velocity: float = 300.0
+    max_accel: float = 3000.0
+    square_corner_velocity: float = 5.0
+    minimum_cruise_ratio: float = 0.5
+    max_z_velocity: float | None = None  # default: max_velocity
+    max_z_accel: float | None = None  # default: max_accel
+    nozzle_diameter: float = 0.4
+    filament_diameter: float = 1.75
+    max_extrude_only_velocity: float | None = None
+    max_extrude_only_accel: float | None = None
+    instantaneous_corner_velocity: float = 1.0
+    arc_resolution: float = 1.0
+    temperature_waits_flush: bool = False  # M109/M190 wait for the heater (a full stop)
+
+    @property
+    def max_e_velocity(self) -> float:
+        # klippy extruder.py: max_velocity * def_max_cross_section / filament_area
+        return self.max_extrude_only_velocity or self.max_velocity * self._cross_ratio
+
+    @property
+    def max_e_accel(self) -> float:
+        return self.max_extrude_only_accel or self.max_accel * self._cross_ratio
+
+    @property
+    def _cross_ratio(self) -> float:
+        area = math.pi * (self.filament_diameter * 0.5) ** 2
+        return 4.0 * self.nozzle_diameter**2 / area
+
+    @classmethod
+    def from_printer_cfg(cls, path: str | os.PathLike) -> "KlipperConfig":
+        """Read the planner's options from a Klipper ``printer.cfg``."""
+        parser = configparser.RawConfigParser(inline_comment_prefixes=("#", ";"), strict=False,
+                                              delimiters=(":", "="))
+        try:
+            with open(path, encoding="utf-8") as f:
+                parser.read_file(f)
+        except (OSError, configparser.Error) as exc:
+            raise ConfigError(f"{path}: cannot read Klipper config: {exc}") from exc
+        if not parser.has_section("printer"):
+            raise ConfigError(f"{path}: no [printer] section")
+
+        def get(section: str, key: str, default=None):
+            if parser.has_option(section, key):
+                raw = parser.get(section, key)
+                try:
+                    return float(raw)
+                except ValueError:
+                    raise ConfigError(f"{path}: [{section}] {key} = {raw!r} is not a number") from None
+            return default
+
+        values = {
+            "max_velocity": get("printer", "max_velocity"),
+            "max_accel": get("printer", "max_accel"),
+            "square_corner_velocity": get("printer", "square_corner_velocity", 5.0),
+            "max_z_velocity": get("printer", "max_z_velocity"),
+            "max_z_accel": get("printer", "max_z_accel"),
+            "nozzle_diameter": get("extruder", "nozzle_diameter", 0.4),
+            "filament_diameter": get("extruder", "filament_diameter", 1.75),
+            "max_extrude_only_velocity": get("extruder", "max_extrude_only_velocity"),
+            "max_extrude_only_accel": get("extruder", "max_extrude_only_accel"),
+            "instantaneous_corner_velocity": get("extruder", "instantaneous_corner_velocity", 1.0),
+            "arc_resolution": get("gcode_arcs", "resolution", 1.0),
+        }
+        for key in ("max_velocity", "max_accel"):
+            if values[key] is None:
+                raise ConfigError(f"{path}: [printer] needs {key}")
+        mcr = get("printer", "minimum_cruise_ratio")
+        atd = get("printer", "max_accel_to_decel")
+        if mcr is None:  # the older option: max_accel_to_decel (default max_accel / 2)
+            mcr = 1.0 - min(atd, values["max_accel"]) / values["max_accel"] if atd is not None else 0.5
+        values["minimum_cruise_ratio"] = mcr
+        return cls(**values)
+
+
+def _named_args(text: str) -> dict[str, float]:
+    out = {}
+    for key, value in re.findall(r"([A-Za-z_]+)\s*=\s*(\S+)", text):
+        try:
+            out[key.upper()] = float(value)
+        except ValueError:
+            continue
+    return out
+
+
+def _velocity_limits(op: "Operation", config: KlipperConfig):
+    """Rows where the toolhead limits change, and the limits after each."""
+    t = op.table
+    rows = []
+    state = dict(max_velocity=config.max_velocity, max_accel=config.max_accel,
+                 square_corner_velocity=config.square_corner_velocity,
+                 minimum_cruise_ratio=config.minimum_cruise_ratio)
+    values = []
+    for row in command_rows(op, codes=("M204", "SET_VELOCITY_LIMIT")).tolist():
+        cmd = t.command(row)
+        if cmd.code == "M204":
+            accel = cmd.params.get("S")
+            if accel is None and "P" in cmd.params and "T" in cmd.params:
+                accel = min(cmd.params["P"], cmd.params["T"])
+            if accel is None or accel <= 0:
+                op.diagnostics.warn(cmd.line, 1, "Klipper ignores M204 without S (or P and T together)", str(cmd))
+                continue
+            state["max_accel"] = accel
+        else:
+            args = _named_args(cmd.text)
+            for key, name in (("VELOCITY", "max_velocity"), ("ACCEL", "max_accel"),
+                              ("SQUARE_CORNER_VELOCITY", "square_corner_velocity"),
+                              ("MINIMUM_CRUISE_RATIO", "minimum_cruise_ratio")):
+                if key in args:
+                    state[name] = args[key]
+            if "ACCEL_TO_DECEL" in args and "MINIMUM_CRUISE_RATIO" not in args:
+                state["minimum_cruise_ratio"] = 1.0 - min(args["ACCEL_TO_DECEL"], state["max_accel"]) / state["max_accel"]
+        rows.append(row)
+        values.append(dict(state))
+    return np.array(rows, np.int64), values
+
+
+def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResult]:
+    """Plan an emulated operation as Klipper would; one result per firmware move."""
+    factor = _speed_factor(op)
+    moves = firmware_moves(op, factor, lambda mm: np.maximum(np.floor(mm / config.arc_resolution), 1.0))
+    axes_d = moves.axes_d
+    n = len(moves)
+    if n == 0:
+        empty = np.zeros(0)
+        return moves, PlanResult(empty, empty, empty, empty, empty, empty, empty)
+
+    rows, limits = _velocity_limits(op, config)
+
+    def limit(name: str) -> np.ndarray:
+        return in_force(moves, rows, [v[name] for v in limits], getattr(config, name))
+
+    max_velocity, max_accel = limit("max_velocity"), limit("max_accel")
+    scv, mcr = limit("square_corner_velocity"), limit("minimum_cruise_ratio")
+    junction_deviation = scv**2 * (math.sqrt(2.0) - 1.0) / max_accel
+    mcr_pseudo_accel = max_accel * (1.0 - mcr)
+
+    # Move.__init__
+    move_d = np.sqrt(np.einsum("ij,ij->i", axes_d[:, :3], axes_d[:, :3]))
+    is_kinematic = move_d >= 1e-9
+    axes_d[~is_kinematic, :3] = 0.0
+    move_d = np.where(is_kinematic, move_d, np.abs(axes_d[:, 3]))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        axes_r = np.where(move_d[:, None] > 0, axes_d / move_d[:, None], 0.0)
+    velocity = np.where(is_kinematic, np.minimum(moves.speed_v, max_velocity), moves.speed_v)
+    accel = np.where(is_kinematic, max_accel, EXTRUDE_ONLY_ACCEL)
+    max_cruise_v2 = velocity**2
+    mcr_delta_v2 = 2.0 * move_d * mcr_pseudo_accel
+
+    # limit_speed() calls: cartesian Z, then the extruder's extrude-only limits
+    speed_caps = [np.full(n, np.inf)]
+    accel_caps = [accel]
+    dz = np.abs(axes_d[:, 2])
+    z_move = is_kinematic & (dz > 0)
+    with np.errstate(divide="ignore"):
+        z_ratio = np.where(z_move, move_d / np.where(z_move, dz, 1.0), np.inf)
+    max_z_velocity = config.max_z_velocity or config.max_velocity
+    max_z_accel = config.max_z_accel or config.max_accel
+    speed_caps.append(np.where(z_move, max_z_velocity * z_ratio, np.inf))
+    accel_caps.append(np.where(z_move, max_z_accel * z_ratio, np.inf))
+    e_r = axes_r[:, 3]
+    e_limited = (axes_d[:, 3] != 0) & (((axes_d[:, 0] == 0) & (axes_d[:, 1] == 0)) | (e_r < 0))
+    with np.errstate(divide="ignore"):
+        inv_extrude_r = np.where(e_limited, 1.0 / np.abs(np.where(e_limited, e_r, 1.0)), np.inf)
+    speed_caps.append(np.where(e_limited, config.max_e_velocity * inv_extrude_r, np.inf))
+    accel_caps.append(np.where(e_limited, config.max_e_accel * inv_extrude_r, np.inf))
+    max_cruise_v2 = np.minimum(max_cruise_v2, np.min(speed_caps, axis=0) ** 2)
+    accel = np.min(accel_caps, axis=0)
+    delta_v2 = 2.0 * move_d * accel
+    mcr_delta_v2 = np.minimum(mcr_delta_v2, delta_v2)
+
+    # Full stops: a flush empties the lookahead queue, so the next move
+    # starts from rest (the first move of a queue gets no junction).
+    flush_names = ("wait_moves", "dwell", "home", "motors_off", "set_kinematic_position")
+    if config.temperature_waits_flush:
+        flush_names += ("wait_hotend_temp", "wait_bed_temp")
+    flush = happens_before(moves, command_rows(op, names=flush_names, codes=("SET_KINEMATIC_POSITION",)))
+    flush[0] = True
+
+    # Move.calc_junction: caps on the squared speed at the start of each move
+    prev = np.r_[0, np.arange(n - 1)]
+    junction = is_kinematic & is_kinematic[prev] & ~flush
+    diff_r = e_r - e_r[prev]
+    with np.errstate(divide="ignore"):
+        ea_v2 = np.where(diff_r != 0, (config.instantaneous_corner_velocity / np.abs(diff_r)) ** 2, max_cruise_v2)
+    cap = np.minimum.reduce([max_cruise_v2, max_cruise_v2[prev], np.full(n, NO_LIMIT_V2), ea_v2])
+    junction_cos_theta = -np.einsum("ij,ij->i", axes_r[:, :3], axes_r[prev, :3])
+    sin_theta_d2 = np.sqrt(np.maximum(0.5 * (1.0 - junction_cos_theta), 0.0))
+    cos_theta_d2 = np.sqrt(np.maximum(0.5 * (1.0 + junction_cos_theta), 0.0))
+    one_minus_sin_theta_d2 = 1.0 - sin_theta_d2
+    corner = (one_minus_sin_theta_d2 > 0) & (cos_theta_d2 > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        R_jd = sin_theta_d2 / one_minus_sin_theta_d2
+        quarter_tan_theta_d2 = 0.25 * sin_theta_d2 / cos_theta_d2
+    corner_caps = np.minimum.reduce([
+        R_jd * junction_deviation * accel,
+        R_jd * junction_deviation[prev] * accel[prev],
+        delta_v2 * quarter_tan_theta_d2,
+        delta_v2[prev] * quarter_tan_theta_d2,
+    ])
+    cap = np.where(corner, np.minimum(cap, corner_caps), cap)
+    cap = np.where(junction, cap, 0.0)
+    # max_start_v2 = min(cap, prev.max_start_v2 + prev.delta_v2): a forward scan
+    max_start_v2 = forward_min(cap, delta_v2)
+    max_mcr_start_v2 = forward_min(np.where(junction, max_start_v2, 0.0), mcr_delta_v2)
+
+    # LookAheadQueue.flush, backward: assume a stop after the last move of each flush
+    start_v2 = backward_min(max_start_v2, delta_v2)
+    mcr_start_v2 = backward_min(max_mcr_start_v2, mcr_delta_v2)
+    segment = np.cumsum(flush)
+    last_of_segment = np.r_[segment[1:] != segment[:-1], True]
+    next_start_v2 = np.where(last_of_segment, 0.0, np.r_[start_v2[1:], 0.0])
+    next_mcr_start_v2 = np.where(last_of_segment, 0.0, np.r_[mcr_start_v2[1:], 0.0])
+    reachable_start_v2 = next_start_v2 + delta_v2
+    reach_mcr_start_v2 = next_mcr_start_v2 + mcr_delta_v2
+    # Klipper compares values its sequential loop made equal on purpose (a
+    # move whose start is limited by braking for the next); the scans round
+    # differently in the last bits, so equal means equal within TIE.
+    tie = TIE * np.maximum(reach_mcr_start_v2, 1.0)
+    can_accel = mcr_start_v2 < reach_mcr_start_v2 - tie
+    # pending_cv2_assign > 1: the move after this one (same flush) could not accelerate
+    pending = ~last_of_segment & ~np.r_[can_accel[1:], True]
+    update = can_accel & ((mcr_start_v2 + mcr_delta_v2 > next_mcr_start_v2 + tie) | pending)
+    nearest = next_marked(update)
+    has_peak = nearest < n
+    nearest_c = np.minimum(nearest, n - 1)
+    peak_cruise_v2 = np.where(has_peak & (segment[nearest_c] == segment),
+                              (mcr_start_v2 + reach_mcr_start_v2)[nearest_c] * 0.5, 0.0)
+    cruise_v2 = np.minimum.reduce([(start_v2 + reachable_start_v2) * 0.5, max_cruise_v2, peak_cruise_v2])
+    # forward: a move that cannot accelerate keeps min(previous cruise, its start)
+    chain = np.cumsum(can_accel | flush)
+    seed = np.where(can_accel, cruise_v2, np.where(flush, np.minimum(0.0, start_v2), start_v2))
+    cruise_v2 = segmented_cummin(seed, chain)
+
+    # Move.set_junction
+    start_v2 = np.minimum(start_v2, cruise_v2)
+    end_v2 = np.minimum(next_start_v2, cruise_v2)
+    half_inv_accel = 0.5 / accel
+    accel_d = (cruise_v2 - start_v2) * half_inv_accel
+    decel_d = (cruise_v2 - end_v2) * half_inv_accel
+    cruise_d = move_d - accel_d - decel_d
+    start_v, cruise_v, end_v = np.sqrt(start_v2), np.sqrt(cruise_v2), np.sqrt(end_v2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        accel_t = np.where(accel_d > 0, accel_d / ((start_v + cruise_v) * 0.5), 0.0)
+        cruise_t = np.where(cruise_d != 0, cruise_d / cruise_v, 0.0)
+        decel_t = np.where(decel_d > 0, decel_d / ((end_v + cruise_v) * 0.5), 0.0)
+    moves.end[~is_kinematic, :3] = moves.start[~is_kinematic, :3]
+    return moves, PlanResult(start_v, cruise_v, end_v, accel, accel_t, cruise_t, decel_t)
+
+
+def _speed_factor(op: "Operation") -> np.ndarray:
+    """M220 S, as a ratio, in force at each waypoint."""
+    t = op.table
+    rows = command_rows(op, names=("set_speed_factor",))
+    w = op.waypoints
+    cmd = w["command"] if "command" in w else np.arange(len(w["x"]))
+    if rows.size == 0:
+        return np.ones(cmd.size)
+    values = t.param("S")[rows] / 100.0
+    values = np.where(np.isnan(values), 1.0, values)
+    k = np.searchsorted(rows, cmd, side="right") - 1
+    return np.where(k >= 0, values[np.maximum(k, 0)], 1.0)
+
