@@ -27,7 +27,7 @@ import pandas as pd
 from .emulate.machine import Machine
 from .emulate.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine
-from .errors import Diagnostics, check_choice
+from .errors import ConfigError, Diagnostics, check_choice
 from .parse import CommandTable, GcodeParser
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
 from .syntax import Flavor, detect_flavor, load_flavor
@@ -165,6 +165,12 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     check_choice("mode", mode, ("lenient", "strict"))
     program = as_program(source)
     fl, config, _ = resolve(program, machine, flavor, **machine_options)
+    if machine_config is not None:
+        if not config.planner:
+            raise ConfigError(f"machine {config.name!r} has no planner to read {os.fspath(machine_config)!r}")
+        from .emulate.planners import machine_options as firmware_options
+
+        config = dataclasses.replace(config, **firmware_options(config.planner, machine_config))
     diagnostics = Diagnostics(program.name, mode)
     parser = GcodeParser(fl, diagnostics)
     m = Machine(config, diagnostics, rapid_is_feed=fl.rapid_is_feed, initial_units=fl.units,

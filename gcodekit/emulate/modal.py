@@ -111,6 +111,11 @@ class ModalHandler:
             self._end_program()
         elif name == "set_kinematic_position":
             self._set_kinematic_position(t.command(row).text)
+        elif name in ("firmware_retract", "firmware_unretract"):
+            filament = self._firmware_retraction(name == "firmware_retract")
+            if filament is not None:
+                self._write(out, row, before, MOTION_LINEAR, *filament)
+                return extra
         for w in extra:
             self._fill_passing(w, before)
             before = np.array([w.values[k] for k in AXES.lower()])
@@ -183,6 +188,23 @@ class ModalHandler:
         for key, value in re.findall(r"\b([XYZ])\s*=\s*([-+]?[0-9.]+)", text.upper()):
             s.position["XYZ".index(key)] = float(value)
 
+    def _firmware_retraction(self, retract: bool) -> tuple[float, float] | None:
+        """G10/G11 on a printer: an extruder-only move of the configured length.
+
+        Returns the filament moved and its feed (mm/min), or None when the
+        machine has no retraction configured or is already in that state.
+        The modal feed is kept (Klipper restores its G-code state after).
+        """
+        s, c = self.state, self.machine.config
+        if c.retract_length <= 0 or s.retracted == retract:
+            return None
+        s.retracted = retract
+        length = c.retract_length if retract else -(c.retract_length + c.unretract_extra_length)
+        speed = c.retract_speed if retract else c.unretract_speed
+        de = -length * s.flow
+        s.e_total += de
+        return de, speed * 60.0
+
     def _end_program(self) -> None:
         """M2/M30: LinuxCNC resets these modes and stops reading the program."""
         s = self.state
@@ -199,16 +221,19 @@ class ModalHandler:
         w.values.update(distance=distance, time=distance / (self.machine.config.rapid_feed / 60.0),
                         de=0.0, cx=np.nan, cy=np.nan, cz=np.nan)
 
-    def _write(self, out: dict, row: int, before: np.ndarray, motion: int) -> None:
+    def _write(self, out: dict, row: int, before: np.ndarray, motion: int, de: float = 0.0,
+               feed: float | None = None) -> None:
         s = self.state
         for k, v in zip(AXES.lower(), s.position):
             out[k][row] = v
         distance = float(np.linalg.norm((s.position - before)[:3]))
         rate = s.feed if (motion == MOTION_LINEAR or self.machine.rapid_is_feed) else self.machine.config.rapid_feed
+        rate = rate if feed is None else feed
+        path = distance or abs(de)
         out["distance"][row] = distance
-        out["time"][row] = distance / (rate / 60.0) if distance and rate > 0 else 0.0
-        out["de"][row] = 0.0
-        out["feed"][row] = s.feed
+        out["time"][row] = path / (rate / 60.0) if path and rate > 0 else 0.0
+        out["de"][row] = de
+        out["feed"][row] = rate if feed is not None else s.feed
         out["motion"][row] = motion
         out["cx"][row] = out["cy"][row] = out["cz"][row] = np.nan
         out["spindle"][row] = s.speed * s.spindle

@@ -73,6 +73,10 @@ class MachineConfig:
         g/cm^3; turns volume into mass.
     work_offsets : mapping of str to list of float
         Initial G54-G59.3 offsets in mm, e.g. ``G55 = [100, 0, 0]``.
+    retract_length, unretract_extra_length : float
+        Firmware retraction (G10/G11) filament length, mm; 0 disables it.
+    retract_speed, unretract_speed : float
+        Firmware retraction speeds, mm/s.
     dwell_s_seconds : bool
         ``G4 S`` is a dwell in seconds (Marlin, RepRapFirmware); Klipper
         ignores S.
@@ -99,6 +103,10 @@ class MachineConfig:
     filament_diameter: float = 1.75
     filament_density: float = 1.24
     work_offsets: Mapping[str, tuple[float, ...]] = field(default_factory=lambda: MappingProxyType({}))
+    retract_length: float = 0.0
+    retract_speed: float = 20.0
+    unretract_extra_length: float = 0.0
+    unretract_speed: float = 10.0
     dwell_s_seconds: bool = True
     planner: str = ""
     planner_settings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))

@@ -47,6 +47,7 @@ class MachineState:
     speed: float = 0.0  # S for the spindle, rpm
     spindle: int = 0  # 1 CW, -1 CCW, 0 stopped
     coolant: int = 0  # bit 1 mist, bit 2 flood
+    retracted: bool = False  # firmware retraction (G10) in effect
     ended: bool = False  # M2/M30 reached: later blocks are not run
 
     @property

@@ -28,6 +28,13 @@ PLANNERS = {
 }
 
 
+def machine_options(name: str, config_file: str | os.PathLike) -> dict[str, Any]:
+    """Emulator settings (filament, firmware retraction) found in a firmware config file."""
+    module = importlib.import_module(PLANNERS[name][0])
+    reader = getattr(module, "machine_options", None)
+    return reader(config_file) if reader else {}
+
+
 def planner_settings(name: str, preset: Mapping[str, Any], config_file: str | os.PathLike | None = None):
     """Settings for planner ``name``: its defaults, the preset's values, then the firmware file."""
     if name not in PLANNERS:

@@ -72,24 +72,7 @@ class KlipperConfig:
     @classmethod
     def from_printer_cfg(cls, path: str | os.PathLike) -> "KlipperConfig":
         """Read the planner's options from a Klipper ``printer.cfg``."""
-        parser = configparser.RawConfigParser(inline_comment_prefixes=("#", ";"), strict=False,
-                                              delimiters=(":", "="))
-        try:
-            with open(path, encoding="utf-8") as f:
-                parser.read_file(f)
-        except (OSError, configparser.Error) as exc:
-            raise ConfigError(f"{path}: cannot read Klipper config: {exc}") from exc
-        if not parser.has_section("printer"):
-            raise ConfigError(f"{path}: no [printer] section")
-
-        def get(section: str, key: str, default=None):
-            if parser.has_option(section, key):
-                raw = parser.get(section, key)
-                try:
-                    return float(raw)
-                except ValueError:
-                    raise ConfigError(f"{path}: [{section}] {key} = {raw!r} is not a number") from None
-            return default
+        get = _cfg_reader(path)
 
         values = {
             "max_velocity": get("printer", "max_velocity"),
@@ -113,6 +96,42 @@ class KlipperConfig:
             mcr = 1.0 - min(atd, values["max_accel"]) / values["max_accel"] if atd is not None else 0.5
         values["minimum_cruise_ratio"] = mcr
         return cls(**values)
+
+
+def _cfg_reader(path: str | os.PathLike):
+    """A ``get(section, key, default)`` for the numbers of a Klipper config file."""
+    parser = configparser.RawConfigParser(inline_comment_prefixes=("#", ";"), strict=False, delimiters=(":", "="))
+    try:
+        with open(path, encoding="utf-8") as f:
+            parser.read_file(f)
+    except (OSError, configparser.Error) as exc:
+        raise ConfigError(f"{path}: cannot read Klipper config: {exc}") from exc
+    if not parser.has_section("printer"):
+        raise ConfigError(f"{path}: no [printer] section (is this a Klipper printer.cfg?)")
+
+    def get(section: str, key: str, default=None):
+        if parser.has_option(section, key):
+            raw = parser.get(section, key)
+            try:
+                return float(raw)
+            except ValueError:
+                raise ConfigError(f"{path}: [{section}] {key} = {raw!r} is not a number") from None
+        return default
+
+    return get
+
+
+def machine_options(path: str | os.PathLike) -> dict[str, float]:
+    """What the emulator (not the planner) needs from ``printer.cfg``: filament and retraction."""
+    get = _cfg_reader(path)
+    return {
+        "filament_diameter": get("extruder", "filament_diameter", 1.75),
+        # klippy extras/firmware_retraction.py defaults
+        "retract_length": get("firmware_retraction", "retract_length", 0.0),
+        "retract_speed": get("firmware_retraction", "retract_speed", 20.0),
+        "unretract_extra_length": get("firmware_retraction", "unretract_extra_length", 0.0),
+        "unretract_speed": get("firmware_retraction", "unretract_speed", 10.0),
+    }
 
 
 def _named_args(text: str) -> dict[str, float]:
