@@ -28,7 +28,7 @@ from .errors import (
     GcodeSyntaxError,
 )
 from .parse import GcodeParser
-from .pipeline import emulate, gcode_file_to_dataframe, gcode_to_operation, parse_program
+from .pipeline import emulate_operation, gcode_file_to_dataframe, gcode_to_operation, parse_program
 from .syntax import detect_flavor, list_flavors, load_flavor
 
 __version__ = "0.1.0"
@@ -37,6 +37,6 @@ __all__ = [
     "AdditiveOperation", "AdditiveProcessData", "ConfigError", "Diagnostic", "GcodeError",
     "GcodeExpressionError", "GcodeLimitError", "GcodeMachineError", "GcodeParser", "GcodeSyntaxError",
     "MachineConfig", "Operation", "ProcessData", "SubtractiveOperation", "SubtractiveProcessData",
-    "detect_flavor", "emulate", "gcode_file_to_dataframe", "gcode_to_operation", "list_flavors",
+    "detect_flavor", "emulate_operation", "gcode_file_to_dataframe", "gcode_to_operation", "list_flavors",
     "list_machines", "load_flavor", "load_machine", "parse_program",
 ]

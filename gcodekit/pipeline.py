@@ -32,7 +32,7 @@ from .parse import CommandTable, GcodeParser
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
 from .syntax import Flavor, detect_flavor, load_flavor
 
-__all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate", "resolve"]
+__all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate_operation", "resolve"]
 
 _O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
 _PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
@@ -113,7 +113,7 @@ def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None,
                file=program.name, flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
 
 
-def emulate(operation: Operation, machine: str | MachineConfig | None = None) -> Operation:
+def emulate_operation(operation: Operation, machine: str | MachineConfig | None = None) -> Operation:
     """Run a parsed operation on a machine; returns the same operation, emulated."""
     config = operation.machine if machine is None else (
         machine if isinstance(machine, MachineConfig) else load_machine(machine))

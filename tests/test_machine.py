@@ -173,7 +173,7 @@ def test_statistics_and_bounds_warn_before_emulation():
     with pytest.warns(UserWarning):
         assert op.get_statistics() is None
     assert len(op.process_data) == 0
-    gcodekit.emulate(op)
+    gcodekit.emulate_operation(op)
     assert op.get_bounds()["max"][0] == 1.0
 
 

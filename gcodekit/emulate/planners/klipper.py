@@ -196,13 +196,16 @@ def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResu
     junction_deviation = scv**2 * (math.sqrt(2.0) - 1.0) / max_accel
     mcr_pseudo_accel = max_accel * (1.0 - mcr)
 
-    # Move.__init__
-    move_d = np.sqrt(np.einsum("ij,ij->i", axes_d[:, :3], axes_d[:, :3]))
+    # Move.__init__, with klippy's order of floating-point operations: corner
+    # speeds at near-reversals depend on the last bits of axes_r.
+    dx, dy, dz = axes_d[:, 0], axes_d[:, 1], axes_d[:, 2]
+    move_d = np.sqrt((dx * dx + dy * dy) + dz * dz)
     is_kinematic = move_d >= 1e-9
     axes_d[~is_kinematic, :3] = 0.0
     move_d = np.where(is_kinematic, move_d, np.abs(axes_d[:, 3]))
     with np.errstate(divide="ignore", invalid="ignore"):
-        axes_r = np.where(move_d[:, None] > 0, axes_d / move_d[:, None], 0.0)
+        inv_move_d = np.where(move_d > 0, 1.0 / move_d, 0.0)
+    axes_r = axes_d * inv_move_d[:, None]
     velocity = np.where(is_kinematic, np.minimum(moves.speed_v, max_velocity), moves.speed_v)
     accel = np.where(is_kinematic, max_accel, EXTRUDE_ONLY_ACCEL)
     max_cruise_v2 = velocity**2
@@ -245,7 +248,8 @@ def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResu
     with np.errstate(divide="ignore"):
         ea_v2 = np.where(diff_r != 0, (config.instantaneous_corner_velocity / np.abs(diff_r)) ** 2, max_cruise_v2)
     cap = np.minimum.reduce([max_cruise_v2, max_cruise_v2[prev], np.full(n, NO_LIMIT_V2), ea_v2])
-    junction_cos_theta = -np.einsum("ij,ij->i", axes_r[:, :3], axes_r[prev, :3])
+    junction_cos_theta = -((axes_r[:, 0] * axes_r[prev, 0] + axes_r[:, 1] * axes_r[prev, 1])
+                           + axes_r[:, 2] * axes_r[prev, 2])
     sin_theta_d2 = np.sqrt(np.maximum(0.5 * (1.0 - junction_cos_theta), 0.0))
     cos_theta_d2 = np.sqrt(np.maximum(0.5 * (1.0 + junction_cos_theta), 0.0))
     one_minus_sin_theta_d2 = 1.0 - sin_theta_d2

@@ -12,8 +12,14 @@ velocities ``v2``:
       for i in reversed(range(n)):  s[i] = min(cap[i], s[i+1] + inc[i])
 
 With ``S`` the running sum of ``inc``, ``m[i] - S[i] = min(cap[i] - S[i],
-m[i-1] - S[i-1])``: a running minimum, ``np.minimum.accumulate``.  The sums
-restart every :data:`BLOCK` moves so that their size never costs precision.
+m[i-1] - S[i-1])``: a running minimum, ``np.minimum.accumulate``.
+
+``cap - S`` rounds away the last digits of small caps (a near-reversal
+corner allows 1e-7 mm^2/s^2), so the scan only decides *which* bound holds
+at each move; the values are then rebuilt exactly: a move bound by its cap
+takes the cap itself, a move bound by its predecessor adds the increments
+since the last cap, as the firmware's loop does.  Sums restart every
+:data:`BLOCK` moves so that their size never costs precision.
 """
 
 from __future__ import annotations
@@ -27,14 +33,16 @@ def forward_min(cap: np.ndarray, inc: np.ndarray, first: float = 0.0) -> np.ndar
     """``m[0] = min(cap[0], first)``; ``m[i] = min(cap[i], m[i-1] + inc[i-1])``."""
     n = cap.size
     out = np.empty(n)
-    carry = first  # value that m[start] may not exceed, from the block before
+    carry = first  # what the move before the block allows at the block's first junction
     for start in range(0, n, BLOCK):
         stop = min(start + BLOCK, n)
         c = cap[start:stop]
-        # reach[k]: what the previous move allows at junction k of the block
+        # s[k]: increments from the block's first move up to move k (exclusive)
         s = np.concatenate([[0.0], np.cumsum(inc[start:stop - 1])])
         bound = np.minimum(c - s, np.r_[carry, np.full(stop - start - 1, np.inf)])
-        m = np.minimum.accumulate(bound) + s
+        approx = np.minimum.accumulate(bound) + s
+        reach = np.r_[carry, approx[:-1] + inc[start:stop - 1]]
+        m = _rebuild(c, s, c <= reach, carry)
         out[start:stop] = m
         carry = m[-1] + inc[stop - 1]
     return out
@@ -49,12 +57,25 @@ def backward_min(cap: np.ndarray, inc: np.ndarray, last: float = 0.0) -> np.ndar
         start = max(stop - BLOCK, 0)
         c = cap[start:stop][::-1]
         d = inc[start:stop][::-1]
-        s = np.cumsum(d)  # s[k]: sum of inc from this move to the block's end
+        s = np.cumsum(d)  # s[k]: increments from the block's end back to move k (inclusive)
         bound = c - s
         bound[0] = min(bound[0], carry)
-        r = np.minimum.accumulate(bound) + s
+        approx = np.minimum.accumulate(bound) + s
+        reach = np.r_[carry, approx[:-1]] + d
+        r = _rebuild(c, s, c <= reach, carry + d[0] - s[0])
         out[start:stop] = r[::-1]
         carry = out[start]
+    return out
+
+
+def _rebuild(cap: np.ndarray, s: np.ndarray, binds: np.ndarray, seed: float) -> np.ndarray:
+    """Exact values: ``cap[k]`` where the cap binds, else the last bound value
+    plus the increments since (``s`` are running sums, ``seed + s`` before any cap)."""
+    k = np.where(binds, np.arange(cap.size), -1)
+    np.maximum.accumulate(k, out=k)
+    base = np.where(k >= 0, cap[np.maximum(k, 0)] - s[np.maximum(k, 0)], seed)
+    out = base + s
+    out[binds] = cap[binds]
     return out
 
 
