@@ -45,6 +45,8 @@ def _parser() -> argparse.ArgumentParser:
 def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--flavor", help="dialect (default: the machine's, else detected)")
     p.add_argument("--machine", help="machine preset (default: the one for the flavor)")
+    p.add_argument("--machine-config", metavar="FILE",
+                   help="the firmware's own settings for the machine's planner (Klipper printer.cfg)")
     p.add_argument("--strict", action="store_true", help="stop at the first error instead of reporting it")
     p.add_argument("--no-progress", action="store_true", help="never show a progress bar")
 
@@ -71,7 +73,7 @@ def _load(path: str, args: argparse.Namespace):
     if os.path.isdir(path):
         raise IsADirectoryError(f"{path} is a directory, not a program")
     progress = sys.stderr.isatty() and not args.no_progress and os.path.getsize(path) > 2_000_000
-    return gcode_to_operation(Path(path), args.machine, flavor=args.flavor,
+    return gcode_to_operation(Path(path), args.machine, flavor=args.flavor, machine_config=args.machine_config,
                               mode="strict" if args.strict else "lenient", progress=progress)
 
 
@@ -89,6 +91,7 @@ def summary(op) -> dict[str, Any]:
         "bounds": bounds,
         "distance_mm": stats["distance_mm"],
         "time_s": stats["time_s"],
+        "planner": op.machine.planner or None,
         "layers": stats["layers"],
         "filament_mm": stats["filament_mm"],
         "tools": stats["tools"],
@@ -139,7 +142,8 @@ def _text(r: dict[str, Any]) -> str:
         f"  extruding {m['extruding']}",
         f"  bounds     min {' '.join(fmt(v) for v in b['min'])}   max {' '.join(fmt(v) for v in b['max'])} mm",
         f"  distance   feed {d['feed']:.1f}  rapid {d['rapid']:.1f}  extruding {d['extrude']:.1f} mm",
-        f"  time       {_duration(r['time_s'])}  (length / feed; acceleration not modelled yet)",
+        f"  time       {_duration(r['time_s'])}  "
+        + (f"(planned like {r['planner']})" if r["planner"] else "(length / feed: no planner for this machine)"),
     ]
     if r["layers"] is not None:
         lines.append(f"  layers     {r['layers']}   filament {r['filament_mm']:.1f} mm")

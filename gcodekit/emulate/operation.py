@@ -299,10 +299,12 @@ class Operation:
     def motions(self) -> pd.DataFrame:
         """One row per motion, in the program's units in force at each move.
 
-        Columns ``line, motion, x, y, z, a, b, c, feed, cx, cy, cz, plane``:
-        end points and arc centres in machine coordinates (all offsets
-        applied), lengths in the units in force (mm or inch), feed in those
-        units per minute (empty for rapids), plane ``XY``/``XZ``/``YZ``.
+        Columns ``line, motion, x, y, z, a, b, c, feed, cx, cy, cz, plane,
+        units, time, t_end``: end points and arc centres in machine
+        coordinates (all offsets applied), lengths in the units in force (mm
+        or inch), feed in those units per minute (empty for rapids), plane
+        ``XY``/``XZ``/``YZ``, the move's duration and the time at its end (s).
+        A planned operation adds ``start_v, cruise_v, end_v`` (units/s).
         """
         if not self._require_emulation("motions()"):
             return pd.DataFrame()
@@ -324,6 +326,11 @@ class Operation:
             frame[key] = w[key][moved] * scale
         frame["plane"] = np.array(["", "XY", "XZ", "YZ"], dtype=object)[w["plane"][moved] - 16]
         frame["units"] = np.where(inch, "in", "mm")
+        frame["time"] = w["time"][moved]
+        frame["t_end"] = self.elapsed_time()[moved]
+        if "cruise_v" in w:  # planned by the machine's firmware model, mm/s
+            for key in ("start_v", "cruise_v", "end_v"):
+                frame[key] = w[key][moved] * scale
         return pd.DataFrame(frame)
 
 

@@ -152,6 +152,7 @@ def _velocity_limits(op: "Operation", config: KlipperConfig):
                  square_corner_velocity=config.square_corner_velocity,
                  minimum_cruise_ratio=config.minimum_cruise_ratio)
     values = []
+    ignored = []
     for row in command_rows(op, codes=("M204", "SET_VELOCITY_LIMIT")).tolist():
         cmd = t.command(row)
         if cmd.code == "M204":
@@ -159,7 +160,7 @@ def _velocity_limits(op: "Operation", config: KlipperConfig):
             if accel is None and "P" in cmd.params and "T" in cmd.params:
                 accel = min(cmd.params["P"], cmd.params["T"])
             if accel is None or accel <= 0:
-                op.diagnostics.warn(cmd.line, 1, "Klipper ignores M204 without S (or P and T together)", str(cmd))
+                ignored.append(cmd)
                 continue
             state["max_accel"] = accel
         else:
@@ -173,6 +174,10 @@ def _velocity_limits(op: "Operation", config: KlipperConfig):
                 state["minimum_cruise_ratio"] = 1.0 - min(args["ACCEL_TO_DECEL"], state["max_accel"]) / state["max_accel"]
         rows.append(row)
         values.append(dict(state))
+    if ignored:
+        first = ignored[0]
+        more = f" ({len(ignored)} such lines)" if len(ignored) > 1 else ""
+        op.diagnostics.warn(first.line, 1, f"Klipper ignores M204 without S (or P and T together){more}", str(first))
     return np.array(rows, np.int64), values
 
 
