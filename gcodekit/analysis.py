@@ -72,3 +72,144 @@ def count_layers(op: "Operation") -> int:
     w = op.waypoints
     extruding = (w["motion"] > 0) & (w["de"] > 0) & (w["distance"] > 0)
     return int(np.unique(np.round(w["z"][extruding], 4)).size)
+
+
+def _row_labels(op: "Operation", pattern: str) -> tuple[np.ndarray, list[str]]:
+    """Per command row, the index of the last comment matching ``pattern`` (-1 before any)."""
+    t = op.table
+    rows, labels = [], []
+    if pattern and t.comment_rows.size:
+        regex = re.compile(pattern)
+        text = t.comment_data.decode("utf-8", "replace")
+        ascii_only = text.isascii()
+        offsets = t.comment_offsets
+        for k in range(t.comment_rows.size):
+            comment = text[offsets[k]:offsets[k + 1]].strip() if ascii_only else t.comment(k)
+            m = regex.search(comment)
+            if m:
+                rows.append(int(t.comment_rows[k]))
+                labels.append(m.group(1) if m.groups() else comment)
+    n = len(t)
+    marks = np.full(n, -1, np.int64)
+    if rows:
+        marks[np.array(rows)] = np.arange(len(rows))
+    np.maximum.accumulate(marks, out=marks)
+    return marks, labels
+
+
+def waypoint_rows(op: "Operation") -> np.ndarray:
+    w = op.waypoints
+    return w["command"] if "command" in w else np.arange(len(op.table))
+
+
+def features(op: "Operation") -> np.ndarray:
+    """Feature name (slicer ``;TYPE:`` comment) of each waypoint; ``""`` before the first."""
+    marks, labels = _row_labels(op, op.flavor.feature_comment if op.flavor else "")
+    names = np.array([""] + labels, dtype=object)
+    return names[marks[waypoint_rows(op)] + 1]
+
+
+def layers(op: "Operation") -> np.ndarray:
+    """Layer number (0-based) of each waypoint, -1 before the first layer.
+
+    From the flavor's layer-change comments when the program has them; else a
+    new layer starts at each new Z height reached by an extruding move.
+    """
+    marks = np.full(len(op.table), -1, np.int64)
+    for pattern in (op.flavor.layer_comments if op.flavor else ()):
+        found, labels = _row_labels(op, f"({pattern})")
+        if labels:
+            marks = found
+            break
+    if (marks >= 0).any():
+        return marks[waypoint_rows(op)]
+    w = op.waypoints
+    extruding = (w["motion"] > 0) & (w["de"] > 0) & (w["distance"] > 0)
+    z = np.round(np.asarray(w["z"]), 4)
+    new_layer = extruding & (z != np.r_[np.nan, z[:-1]])
+    starts = np.flatnonzero(new_layer)
+    # a layer begins at its first extruding move; heights already printed are not new
+    seen = np.unique(z[starts], return_index=True)[1]
+    first = np.zeros(z.size, bool)
+    first[starts[np.sort(seen)]] = True
+    return np.cumsum(first) - 1
+
+
+def time_by(op: "Operation", key: str = "layer") -> "pd.DataFrame":
+    """Time, distances and filament per layer, feature or tool.
+
+    Parameters
+    ----------
+    key : {"layer", "feature", "tool"}, default: "layer"
+
+    Returns
+    -------
+    DataFrame indexed by the key with ``time_s``, ``distance_mm``,
+    ``extrude_mm`` (path length while extruding) and ``filament_mm``.
+    """
+    import pandas as pd
+
+    from .errors import check_choice
+
+    check_choice("key", key, ("layer", "feature", "tool"))
+    w = op.waypoints
+    labels = {"layer": layers, "feature": features, "tool": lambda o: np.asarray(o.waypoints["tool"])}[key](op)
+    extruding = (w["motion"] > 0) & (w["de"] > 0)
+    frame = pd.DataFrame({
+        key: labels,
+        "time_s": np.nan_to_num(np.asarray(w["time"], float)),
+        "distance_mm": np.asarray(w["distance"], float),
+        "extrude_mm": np.where(extruding, w["distance"], 0.0),
+        "filament_mm": np.asarray(w["de"], float),
+    })
+    return frame.groupby(key, sort=(key != "feature")).sum()
+
+
+def velocity_profile(op: "Operation") -> "pd.DataFrame":
+    """Speed over time, for plots: planned (trapezoids) and commanded.
+
+    One row per corner of each move's velocity trapezoid: ``time`` (s),
+    ``distance`` (mm travelled so far), ``planned`` and ``commanded`` speed
+    (mm/s), and the source ``line``.  Without a planner the planned speed is
+    the commanded one, held for each move.
+    """
+    import pandas as pd
+
+    plan = getattr(op, "plan", None)
+    if plan is None:
+        w = op.waypoints
+        moved = np.flatnonzero(w["motion"] > 0)
+        t_end = op.elapsed_time()[moved]
+        dur = np.nan_to_num(np.asarray(w["time"], float)[moved])
+        speed = np.asarray(w["feed"], float)[moved] / 60.0
+        d_end = np.cumsum(np.asarray(w["distance"], float)[moved])
+        d_start = d_end - np.asarray(w["distance"], float)[moved]
+        line = op.table.line[waypoint_rows(op)[moved]]
+        return pd.DataFrame({
+            "time": np.column_stack([t_end - dur, t_end]).ravel(),
+            "distance": np.column_stack([d_start, d_end]).ravel(),
+            "planned": np.repeat(speed, 2), "commanded": np.repeat(speed, 2), "line": np.repeat(line, 2),
+        })
+    moves, r = plan
+    w = op.waypoints
+    # a move starts when its waypoint started plus the moves of that waypoint before it
+    dur = r.duration_t
+    t_end_wp = op.elapsed_time()
+    t_start_wp = t_end_wp - np.nan_to_num(np.asarray(w["time"], float))
+    within = np.cumsum(dur) - dur
+    first = np.r_[0, np.flatnonzero(moves.waypoint[1:] != moves.waypoint[:-1]) + 1]
+    offset = np.repeat(within[first], np.diff(np.r_[first, len(moves)]))
+    t0 = t_start_wp[moves.waypoint] + (within - offset)
+    d = np.linalg.norm(moves.axes_d[:, :3], axis=1)
+    d = np.where(d > 0, d, np.abs(moves.axes_d[:, 3]))
+    d0 = np.cumsum(d) - d
+    accel_d = (r.cruise_v**2 - r.start_v**2) / (2 * r.accel)
+    decel_d = (r.cruise_v**2 - r.end_v**2) / (2 * r.accel)
+    times = np.column_stack([t0, t0 + r.accel_t, t0 + r.accel_t + r.cruise_t, t0 + dur])
+    dist = np.column_stack([d0, d0 + accel_d, d0 + d - decel_d, d0 + d])
+    speed = np.column_stack([r.start_v, r.cruise_v, r.cruise_v, r.end_v])
+    commanded = np.repeat(moves.speed_v, 4)
+    return pd.DataFrame({
+        "time": times.ravel(), "distance": dist.ravel(), "planned": speed.ravel(), "commanded": commanded,
+        "line": np.repeat(op.table.line[moves.row], 4),
+    })

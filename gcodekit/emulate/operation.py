@@ -248,6 +248,22 @@ class Operation:
 
     # -- tables -------------------------------------------------------------------
 
+    def time_by(self, key: str = "layer") -> pd.DataFrame:
+        """Time, distance and filament per ``"layer"``, ``"feature"`` or ``"tool"``."""
+        if not self._require_emulation("time_by()"):
+            return pd.DataFrame()
+        from ..analysis import time_by
+
+        return time_by(self, key)
+
+    def velocity_profile(self) -> pd.DataFrame:
+        """Planned and commanded speed over time (see :func:`gcodekit.analysis.velocity_profile`)."""
+        if not self._require_emulation("velocity_profile()"):
+            return pd.DataFrame()
+        from ..analysis import velocity_profile
+
+        return velocity_profile(self)
+
     def to_dataframe(self) -> pd.DataFrame:
         """One row per waypoint: command columns then process columns.
 
@@ -271,6 +287,9 @@ class Operation:
         for key in SMALL_COLUMNS:
             data[key] = w[key]
         data["motion"] = pd.Categorical.from_codes(w["motion"], categories=["none", *MOTION_NAMES[1:]])
+        for key in ("start_v", "cruise_v", "end_v", "accel"):
+            if key in w:
+                data[key] = w[key]
         data["elapsed_time"] = self.elapsed_time()
         return pd.DataFrame(data, copy=False)
 
