@@ -25,6 +25,7 @@ if TYPE_CHECKING:
 #: Planner name -> (module, settings class, reader of the firmware's own config file)
 PLANNERS = {
     "klipper": ("gcodekit.emulate.planners.klipper", "KlipperConfig", "from_printer_cfg"),
+    "motion_profile": ("gcodekit.emulate.planners.motion_profile", "MotionProfileConfig", "from_config_file"),
 }
 
 

@@ -12,6 +12,7 @@ Names follow Klipper's suffixes: ``_d`` mm, ``_v`` mm/s, ``_v2`` mm^2/s^2,
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
@@ -84,9 +85,14 @@ def command_rows(op: "Operation", *, names: tuple[str, ...] = (), codes: tuple[s
     ids = [NAME_ID[n] for n in names if n in NAME_ID]
     if ids:
         mask |= np.isin(t.name, ids)
-    if codes:
-        labels = op._codes()
-        mask |= np.isin(labels, list(codes))
+    for code in codes:
+        m = re.fullmatch(r"([GMT])(\d+)(?:\.(\d))?", code)
+        if m:  # compare letter and number columns, no strings per row
+            tenths = int(m.group(2)) * 10 + int(m.group(3) or 0)
+            mask |= (t.letter == ord(m.group(1))) & (t.number == tenths)
+        else:
+            rows = [r for r, (name, _) in t.named.items() if name.upper() == code]
+            mask[rows] = True
     return np.flatnonzero(mask)
 
 
@@ -124,13 +130,19 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     """
     w = op.waypoints
     n = w["x"].size
-    position = np.column_stack([w["x"], w["y"], w["z"], np.cumsum(w["de"])])
-    previous = np.vstack([np.zeros((1, 4)), position[:-1]])
+    position = np.empty((n, 4))
+    for k, key in enumerate("xyz"):
+        position[:, k] = w[key]
+    np.cumsum(w["de"], out=position[:, 3])
+    previous = np.empty_like(position)
+    previous[0] = 0.0
+    previous[1:] = position[:-1]
     rows = w["command"] if "command" in w else np.arange(n)
     # Homing moves go to an endstop from wherever the axis really is: their
     # length and time are unknown, and firmware time estimates leave them out.
     homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
-    moving = (w["motion"] > 0) & np.any(position != previous, axis=1) & ~homing
+    moving = (w["motion"] > 0) & ~homing
+    moving &= (position != previous).any(axis=1)
     speed = np.asarray(w["feed"], float) / 60.0
     if speed_factor is not None:
         speed = speed * speed_factor

@@ -145,56 +145,98 @@ def _named_args(text: str) -> dict[str, float]:
 
 
 def _velocity_limits(op: "Operation", config: KlipperConfig):
-    """Rows where the toolhead limits change, and the limits after each."""
+    """Rows where the toolhead limits change, and the limits after each.
+
+    M204 rows are read as columns (a sliced print has one per feature);
+    SET_VELOCITY_LIMIT rows are few and parsed one by one.
+    """
     t = op.table
-    rows = []
-    state = dict(max_velocity=config.max_velocity, max_accel=config.max_accel,
-                 square_corner_velocity=config.square_corner_velocity,
-                 minimum_cruise_ratio=config.minimum_cruise_ratio)
-    values = []
-    ignored = []
-    for row in command_rows(op, codes=("M204", "SET_VELOCITY_LIMIT")).tolist():
-        cmd = t.command(row)
-        if cmd.code == "M204":
-            accel = cmd.params.get("S")
-            if accel is None and "P" in cmd.params and "T" in cmd.params:
-                accel = min(cmd.params["P"], cmd.params["T"])
-            if accel is None or accel <= 0:
-                ignored.append(cmd)
-                continue
-            state["max_accel"] = accel
+    m204 = command_rows(op, codes=("M204",))
+    s_word, p_word, t_word = (t.param(k)[m204] for k in "SPT")
+    accel = np.where(np.isnan(s_word), np.fmin(p_word, t_word) * (~np.isnan(p_word) & ~np.isnan(t_word)), s_word)
+    accel[~(accel > 0)] = np.nan  # Klipper ignores M204 without S (or P and T together)
+    ignored = m204[np.isnan(accel)]
+    if ignored.size:
+        first = t.command(int(ignored[0]))
+        more = f" ({ignored.size} such lines)" if ignored.size > 1 else ""
+        op.diagnostics.warn(first.line, 1, f"Klipper ignores M204 without S (or P and T together){more}", str(first))
+    events = {int(r): ("M204", float(a)) for r, a in zip(m204, accel) if a == a}
+    for row in command_rows(op, codes=("SET_VELOCITY_LIMIT",)).tolist():
+        events[row] = ("SET_VELOCITY_LIMIT", _named_args(t.command(row).text))
+    rows = np.array(sorted(events), np.int64)
+    columns = {name: np.empty(rows.size) for name in ("max_velocity", "max_accel", "square_corner_velocity",
+                                                     "minimum_cruise_ratio")}
+    state = {name: getattr(config, name) for name in columns}
+    only_m204 = all(kind == "M204" for kind, _ in events.values())
+    if only_m204:  # the common case: the acceleration alone changes
+        for name in columns:
+            columns[name][:] = state[name]
+        columns["max_accel"][:] = [events[r][1] for r in rows.tolist()]
+        return rows, columns
+    for k, row in enumerate(rows.tolist()):
+        kind, value = events[row]
+        if kind == "M204":
+            state["max_accel"] = value
         else:
-            args = _named_args(cmd.text)
             for key, name in (("VELOCITY", "max_velocity"), ("ACCEL", "max_accel"),
                               ("SQUARE_CORNER_VELOCITY", "square_corner_velocity"),
                               ("MINIMUM_CRUISE_RATIO", "minimum_cruise_ratio")):
-                if key in args:
-                    state[name] = args[key]
-            if "ACCEL_TO_DECEL" in args and "MINIMUM_CRUISE_RATIO" not in args:
-                state["minimum_cruise_ratio"] = 1.0 - min(args["ACCEL_TO_DECEL"], state["max_accel"]) / state["max_accel"]
-        rows.append(row)
-        values.append(dict(state))
-    if ignored:
-        first = ignored[0]
-        more = f" ({len(ignored)} such lines)" if len(ignored) > 1 else ""
-        op.diagnostics.warn(first.line, 1, f"Klipper ignores M204 without S (or P and T together){more}", str(first))
-    return np.array(rows, np.int64), values
+                if key in value:
+                    state[name] = value[key]
+            if "ACCEL_TO_DECEL" in value and "MINIMUM_CRUISE_RATIO" not in value:
+                state["minimum_cruise_ratio"] = 1.0 - min(value["ACCEL_TO_DECEL"], state["max_accel"]) / state["max_accel"]
+        for name in columns:
+            columns[name][k] = state[name]
+    return rows, columns
+
+
+#: Moves handled at once by the element-wise steps: small blocks reuse
+#: memory instead of touching fresh pages for every temporary array.
+BLOCK = 1 << 16
 
 
 def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResult]:
     """Plan an emulated operation as Klipper would; one result per firmware move."""
     factor = _speed_factor(op)
     moves = firmware_moves(op, factor, lambda mm: np.maximum(np.floor(mm / config.arc_resolution), 1.0))
-    axes_d = moves.axes_d
     n = len(moves)
     if n == 0:
         empty = np.zeros(0)
         return moves, PlanResult(empty, empty, empty, empty, empty, empty, empty)
-
     rows, limits = _velocity_limits(op, config)
+    flush_names = ("wait_moves", "dwell", "home", "motors_off", "set_kinematic_position")
+    if config.temperature_waits_flush:
+        flush_names += ("wait_hotend_temp", "wait_bed_temp")
+    # Full stops: a flush empties the lookahead queue, so the next move
+    # starts from rest (the first move of a queue gets no junction).
+    flush = happens_before(moves, command_rows(op, names=flush_names, codes=("SET_KINEMATIC_POSITION",)))
+    flush[0] = True
+
+    m = {k: np.empty(n) for k in ("move_d", "accel", "max_cruise_v2", "delta_v2", "mcr_delta_v2", "cap")}
+    junction = np.empty(n, bool)
+    for lo in range(0, n, BLOCK):
+        hi = min(lo + BLOCK, n)
+        _move_block(moves, rows, limits, config, flush, lo, hi, m, junction)
+
+    # max_start_v2 = min(cap, prev.max_start_v2 + prev.delta_v2): forward scans
+    max_start_v2 = forward_min(m["cap"], m["delta_v2"])
+    max_mcr_start_v2 = forward_min(np.where(junction, max_start_v2, 0.0), m["mcr_delta_v2"])
+    # LookAheadQueue.flush, backward: assume a stop after the last move of each flush
+    start_v2 = backward_min(max_start_v2, m["delta_v2"])
+    mcr_start_v2 = backward_min(max_mcr_start_v2, m["mcr_delta_v2"])
+    del max_start_v2, max_mcr_start_v2
+    cruise_v2, next_start_v2 = _cruise(start_v2, mcr_start_v2, m, flush)
+    return moves, _set_junction(start_v2, cruise_v2, next_start_v2, m)
+
+
+def _move_block(moves, rows, limits, config, flush, lo, hi, m, junction) -> None:
+    """Move.__init__, limit_speed and calc_junction for moves ``lo:hi``."""
+    first = max(lo - 1, 0)  # the move before the block, for its junction
+    sl = slice(first, hi)
+    block = moves.select(sl)
 
     def limit(name: str) -> np.ndarray:
-        return in_force(moves, rows, [v[name] for v in limits], getattr(config, name))
+        return in_force(block, rows, limits[name], getattr(config, name))
 
     max_velocity, max_accel = limit("max_velocity"), limit("max_accel")
     scv, mcr = limit("square_corner_velocity"), limit("minimum_cruise_ratio")
@@ -203,6 +245,7 @@ def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResu
 
     # Move.__init__, with klippy's order of floating-point operations: corner
     # speeds at near-reversals depend on the last bits of axes_r.
+    axes_d = block.axes_d
     dx, dy, dz = axes_d[:, 0], axes_d[:, 1], axes_d[:, 2]
     move_d = np.sqrt((dx * dx + dy * dy) + dz * dz)
     is_kinematic = move_d >= 1e-9
@@ -211,50 +254,39 @@ def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResu
     with np.errstate(divide="ignore", invalid="ignore"):
         inv_move_d = np.where(move_d > 0, 1.0 / move_d, 0.0)
     axes_r = axes_d * inv_move_d[:, None]
-    velocity = np.where(is_kinematic, np.minimum(moves.speed_v, max_velocity), moves.speed_v)
+    velocity = np.where(is_kinematic, np.minimum(block.speed_v, max_velocity), block.speed_v)
     accel = np.where(is_kinematic, max_accel, EXTRUDE_ONLY_ACCEL)
     max_cruise_v2 = velocity**2
     mcr_delta_v2 = 2.0 * move_d * mcr_pseudo_accel
 
-    # limit_speed() calls: cartesian Z, then the extruder's extrude-only limits
-    speed_caps = [np.full(n, np.inf)]
-    accel_caps = [accel]
-    dz = np.abs(axes_d[:, 2])
-    z_move = is_kinematic & (dz > 0)
-    with np.errstate(divide="ignore"):
-        z_ratio = np.where(z_move, move_d / np.where(z_move, dz, 1.0), np.inf)
-    max_z_velocity = config.max_z_velocity or config.max_velocity
-    max_z_accel = config.max_z_accel or config.max_accel
-    speed_caps.append(np.where(z_move, max_z_velocity * z_ratio, np.inf))
-    accel_caps.append(np.where(z_move, max_z_accel * z_ratio, np.inf))
-    e_r = axes_r[:, 3]
-    e_limited = (axes_d[:, 3] != 0) & (((axes_d[:, 0] == 0) & (axes_d[:, 1] == 0)) | (e_r < 0))
-    with np.errstate(divide="ignore"):
-        inv_extrude_r = np.where(e_limited, 1.0 / np.abs(np.where(e_limited, e_r, 1.0)), np.inf)
-    speed_caps.append(np.where(e_limited, config.max_e_velocity * inv_extrude_r, np.inf))
-    accel_caps.append(np.where(e_limited, config.max_e_accel * inv_extrude_r, np.inf))
-    max_cruise_v2 = np.minimum(max_cruise_v2, np.min(speed_caps, axis=0) ** 2)
-    accel = np.min(accel_caps, axis=0)
+    # limit_speed(): cartesian Z, then the extruder's extrude-only limits
+    abs_dz = np.abs(axes_d[:, 2])
+    z_move = is_kinematic & (abs_dz > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z_ratio = np.where(z_move, move_d / abs_dz, np.inf)
+        e_r = axes_r[:, 3]
+        e_limited = (axes_d[:, 3] != 0) & (((axes_d[:, 0] == 0) & (axes_d[:, 1] == 0)) | (e_r < 0))
+        inv_extrude_r = np.where(e_limited, 1.0 / np.abs(e_r), np.inf)
+    speed_cap = _minimum(np.where(z_move, (config.max_z_velocity or config.max_velocity) * z_ratio, np.inf),
+                         np.where(e_limited, config.max_e_velocity * inv_extrude_r, np.inf))
+    np.minimum(max_cruise_v2, speed_cap**2, out=max_cruise_v2)
+    accel = _minimum(accel, np.where(z_move, (config.max_z_accel or config.max_accel) * z_ratio, np.inf),
+                     np.where(e_limited, config.max_e_accel * inv_extrude_r, np.inf))
     delta_v2 = 2.0 * move_d * accel
-    mcr_delta_v2 = np.minimum(mcr_delta_v2, delta_v2)
-
-    # Full stops: a flush empties the lookahead queue, so the next move
-    # starts from rest (the first move of a queue gets no junction).
-    flush_names = ("wait_moves", "dwell", "home", "motors_off", "set_kinematic_position")
-    if config.temperature_waits_flush:
-        flush_names += ("wait_hotend_temp", "wait_bed_temp")
-    flush = happens_before(moves, command_rows(op, names=flush_names, codes=("SET_KINEMATIC_POSITION",)))
-    flush[0] = True
+    np.minimum(mcr_delta_v2, delta_v2, out=mcr_delta_v2)
 
     # Move.calc_junction: caps on the squared speed at the start of each move
-    prev = np.r_[0, np.arange(n - 1)]
-    junction = is_kinematic & is_kinematic[prev] & ~flush
-    diff_r = e_r - e_r[prev]
+    # (index k of the block against k - 1; the first is the move before lo).
+    cur, prv = slice(1, None), slice(0, -1)
+    ea_v2 = np.empty(hi - first - 1)
+    diff_r = e_r[cur] - e_r[prv]
     with np.errstate(divide="ignore"):
-        ea_v2 = np.where(diff_r != 0, (config.instantaneous_corner_velocity / np.abs(diff_r)) ** 2, max_cruise_v2)
-    cap = np.minimum.reduce([max_cruise_v2, max_cruise_v2[prev], np.full(n, NO_LIMIT_V2), ea_v2])
-    junction_cos_theta = -((axes_r[:, 0] * axes_r[prev, 0] + axes_r[:, 1] * axes_r[prev, 1])
-                           + axes_r[:, 2] * axes_r[prev, 2])
+        ea_v2 = np.where(diff_r != 0, (config.instantaneous_corner_velocity / np.abs(diff_r)) ** 2,
+                         max_cruise_v2[cur])
+    cap = _minimum(max_cruise_v2[cur], max_cruise_v2[prv], ea_v2)
+    np.minimum(cap, NO_LIMIT_V2, out=cap)
+    junction_cos_theta = -((axes_r[cur, 0] * axes_r[prv, 0] + axes_r[cur, 1] * axes_r[prv, 1])
+                           + axes_r[cur, 2] * axes_r[prv, 2])
     sin_theta_d2 = np.sqrt(np.maximum(0.5 * (1.0 - junction_cos_theta), 0.0))
     cos_theta_d2 = np.sqrt(np.maximum(0.5 * (1.0 + junction_cos_theta), 0.0))
     one_minus_sin_theta_d2 = 1.0 - sin_theta_d2
@@ -262,27 +294,41 @@ def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResu
     with np.errstate(divide="ignore", invalid="ignore"):
         R_jd = sin_theta_d2 / one_minus_sin_theta_d2
         quarter_tan_theta_d2 = 0.25 * sin_theta_d2 / cos_theta_d2
-    corner_caps = np.minimum.reduce([
-        R_jd * junction_deviation * accel,
-        R_jd * junction_deviation[prev] * accel[prev],
-        delta_v2 * quarter_tan_theta_d2,
-        delta_v2[prev] * quarter_tan_theta_d2,
-    ])
+        corner_caps = _minimum(
+            R_jd * junction_deviation[cur] * accel[cur],
+            R_jd * junction_deviation[prv] * accel[prv],
+            delta_v2[cur] * quarter_tan_theta_d2,
+            delta_v2[prv] * quarter_tan_theta_d2,
+        )
     cap = np.where(corner, np.minimum(cap, corner_caps), cap)
-    cap = np.where(junction, cap, 0.0)
-    # max_start_v2 = min(cap, prev.max_start_v2 + prev.delta_v2): a forward scan
-    max_start_v2 = forward_min(cap, delta_v2)
-    max_mcr_start_v2 = forward_min(np.where(junction, max_start_v2, 0.0), mcr_delta_v2)
+    joins = is_kinematic[cur] & is_kinematic[prv]
 
-    # LookAheadQueue.flush, backward: assume a stop after the last move of each flush
-    start_v2 = backward_min(max_start_v2, delta_v2)
-    mcr_start_v2 = backward_min(max_mcr_start_v2, mcr_delta_v2)
+    skip = lo - first  # 1 except for the very first block
+    out = slice(lo, hi)
+    m["move_d"][out] = move_d[skip:]
+    m["accel"][out] = accel[skip:]
+    m["max_cruise_v2"][out] = max_cruise_v2[skip:]
+    m["delta_v2"][out] = delta_v2[skip:]
+    m["mcr_delta_v2"][out] = mcr_delta_v2[skip:]
+    if skip:
+        junction[out] = joins & ~flush[out]
+        m["cap"][out] = np.where(junction[out], cap, 0.0)
+    else:  # the first move of the program has no junction
+        junction[lo] = False
+        m["cap"][lo] = 0.0
+        junction[lo + 1:hi] = joins & ~flush[lo + 1:hi]
+        m["cap"][lo + 1:hi] = np.where(junction[lo + 1:hi], cap, 0.0)
+
+
+def _cruise(start_v2, mcr_start_v2, m, flush):
+    """LookAheadQueue.flush: each move's cruise speed, and the next move's start."""
+    n = start_v2.size
     segment = np.cumsum(flush)
     last_of_segment = np.r_[segment[1:] != segment[:-1], True]
     next_start_v2 = np.where(last_of_segment, 0.0, np.r_[start_v2[1:], 0.0])
     next_mcr_start_v2 = np.where(last_of_segment, 0.0, np.r_[mcr_start_v2[1:], 0.0])
-    reachable_start_v2 = next_start_v2 + delta_v2
-    reach_mcr_start_v2 = next_mcr_start_v2 + mcr_delta_v2
+    reachable_start_v2 = next_start_v2 + m["delta_v2"]
+    reach_mcr_start_v2 = next_mcr_start_v2 + m["mcr_delta_v2"]
     # Klipper compares values its sequential loop made equal on purpose (a
     # move whose start is limited by braking for the next); the scans round
     # differently in the last bits, so equal means equal within TIE.
@@ -290,32 +336,39 @@ def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResu
     can_accel = mcr_start_v2 < reach_mcr_start_v2 - tie
     # pending_cv2_assign > 1: the move after this one (same flush) could not accelerate
     pending = ~last_of_segment & ~np.r_[can_accel[1:], True]
-    update = can_accel & ((mcr_start_v2 + mcr_delta_v2 > next_mcr_start_v2 + tie) | pending)
-    nearest = next_marked(update)
-    has_peak = nearest < n
-    nearest_c = np.minimum(nearest, n - 1)
-    peak_cruise_v2 = np.where(has_peak & (segment[nearest_c] == segment),
-                              (mcr_start_v2 + reach_mcr_start_v2)[nearest_c] * 0.5, 0.0)
-    cruise_v2 = np.minimum.reduce([(start_v2 + reachable_start_v2) * 0.5, max_cruise_v2, peak_cruise_v2])
+    update = can_accel & ((mcr_start_v2 + m["mcr_delta_v2"] > next_mcr_start_v2 + tie) | pending)
+    nearest = np.minimum(next_marked(update), n - 1)
+    has_peak = update[nearest] & (segment[nearest] == segment)
+    peak_cruise_v2 = np.where(has_peak, (mcr_start_v2 + reach_mcr_start_v2)[nearest] * 0.5, 0.0)
+    cruise_v2 = _minimum((start_v2 + reachable_start_v2) * 0.5, m["max_cruise_v2"], peak_cruise_v2)
     # forward: a move that cannot accelerate keeps min(previous cruise, its start)
     chain = np.cumsum(can_accel | flush)
-    seed = np.where(can_accel, cruise_v2, np.where(flush, np.minimum(0.0, start_v2), start_v2))
-    cruise_v2 = segmented_cummin(seed, chain)
+    seed = np.where(can_accel, cruise_v2, np.where(flush, 0.0, start_v2))
+    return segmented_cummin(seed, chain), next_start_v2
 
-    # Move.set_junction
+
+def _set_junction(start_v2, cruise_v2, next_start_v2, m) -> PlanResult:
+    """Move.set_junction: the trapezoid of each move."""
     start_v2 = np.minimum(start_v2, cruise_v2)
     end_v2 = np.minimum(next_start_v2, cruise_v2)
-    half_inv_accel = 0.5 / accel
+    half_inv_accel = 0.5 / m["accel"]
     accel_d = (cruise_v2 - start_v2) * half_inv_accel
     decel_d = (cruise_v2 - end_v2) * half_inv_accel
-    cruise_d = move_d - accel_d - decel_d
+    cruise_d = m["move_d"] - accel_d - decel_d
     start_v, cruise_v, end_v = np.sqrt(start_v2), np.sqrt(cruise_v2), np.sqrt(end_v2)
     with np.errstate(divide="ignore", invalid="ignore"):
         accel_t = np.where(accel_d > 0, accel_d / ((start_v + cruise_v) * 0.5), 0.0)
         cruise_t = np.where(cruise_d != 0, cruise_d / cruise_v, 0.0)
         decel_t = np.where(decel_d > 0, decel_d / ((end_v + cruise_v) * 0.5), 0.0)
-    moves.end[~is_kinematic, :3] = moves.start[~is_kinematic, :3]
-    return moves, PlanResult(start_v, cruise_v, end_v, accel, accel_t, cruise_t, decel_t)
+    return PlanResult(start_v, cruise_v, end_v, m["accel"], accel_t, cruise_t, decel_t)
+
+
+def _minimum(first: np.ndarray, *others: np.ndarray) -> np.ndarray:
+    """Element-wise minimum of several arrays (np.minimum.reduce on a list copies them all)."""
+    out = np.array(first, dtype=float)
+    for other in others:
+        np.minimum(out, other, out=out)
+    return out
 
 
 def _speed_factor(op: "Operation") -> np.ndarray:
