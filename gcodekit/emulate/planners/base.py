@@ -130,37 +130,42 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     """
     w = op.waypoints
     n = w["x"].size
-    position = np.empty((n, 4))
-    for k, key in enumerate("xyz"):
-        position[:, k] = w[key]
-    np.cumsum(w["de"], out=position[:, 3])
-    previous = np.empty_like(position)
-    previous[0] = 0.0
-    previous[1:] = position[:-1]
+    e = np.cumsum(w["de"])
+    columns = (w["x"], w["y"], w["z"], e)
     rows = w["command"] if "command" in w else np.arange(n)
     # Homing moves go to an endstop from wherever the axis really is: their
     # length and time are unknown, and firmware time estimates leave them out.
     homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
-    moving = (w["motion"] > 0) & ~homing
-    moving &= (position != previous).any(axis=1)
-    speed = np.asarray(w["feed"], float) / 60.0
+    changed = np.zeros(n, bool)
+    for col in columns:  # compare with the previous waypoint column by column
+        changed[0] |= col[0] != 0
+        changed[1:] |= col[1:] != col[:-1]
+    idx = np.flatnonzero((w["motion"] > 0) & ~homing & changed)
+    end = np.empty((idx.size, 4))
+    start = np.empty((idx.size, 4))
+    before = idx - 1
+    for k, col in enumerate(columns):
+        end[:, k] = col[idx]
+        start[:, k] = col[np.maximum(before, 0)]
+    if idx.size and idx[0] == 0:
+        start[0] = 0.0
+    speed = np.asarray(w["feed"], float)[idx] / 60.0
     if speed_factor is not None:
-        speed = speed * speed_factor
-    idx = np.flatnonzero(moving)
+        speed *= speed_factor[idx]
     is_arc = w["motion"][idx] >= 3
     if arc_segments is None or not is_arc.any():
-        return PlannerMoves(previous[idx], position[idx], speed[idx], rows[idx], idx)
-    return _with_segmented_arcs(w, idx, is_arc, previous, position, speed, rows, arc_segments)
+        return PlannerMoves(start, end, speed, rows[idx], idx)
+    return _with_segmented_arcs(w, idx, is_arc, start, end, speed, rows[idx], arc_segments)
 
 
-def _with_segmented_arcs(w, idx, is_arc, previous, position, speed, rows, arc_segments) -> PlannerMoves:
+def _with_segmented_arcs(w, idx, is_arc, move_start, move_end, speed, rows, arc_segments) -> PlannerMoves:
     """Replace each arc waypoint by its chords (Klipper's and Marlin's plan_arc)."""
     counts = np.ones(idx.size, np.int64)
     arc_idx = idx[is_arc]
     centers = np.column_stack([w["cx"], w["cy"], w["cz"]])[arc_idx]
     planes = np.asarray(w["plane"])[arc_idx]
-    start = previous[arc_idx]
-    end = position[arc_idx]
+    start = move_start[is_arc]
+    end = move_end[is_arc]
     cw = np.asarray(w["motion"])[arc_idx] == 3
     angle = np.zeros(arc_idx.size)
     radius = np.zeros(arc_idx.size)
@@ -182,7 +187,7 @@ def _with_segmented_arcs(w, idx, is_arc, previous, position, speed, rows, arc_se
     owner = np.repeat(np.arange(idx.size), counts)
     step = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts) + 1  # 1..k within a move
     frac = step / counts[owner]
-    end_all = previous[idx][owner] + (position[idx] - previous[idx])[owner] * frac[:, None]
+    end_all = move_start[owner] + (move_end - move_start)[owner] * frac[:, None]
     arc_pos = np.flatnonzero(is_arc)
     which = np.full(idx.size, -1)
     which[arc_pos] = np.arange(arc_pos.size)
@@ -195,7 +200,7 @@ def _with_segmented_arcs(w, idx, is_arc, previous, position, speed, rows, arc_se
     rows_sel = np.flatnonzero(sel)
     end_all[rows_sel, axes[k, 0]] = centers[k, axes[k, 0]] + radius[k] * np.cos(a0 + theta)
     end_all[rows_sel, axes[k, 1]] = centers[k, axes[k, 1]] + radius[k] * np.sin(a0 + theta)
-    start_all = np.vstack([previous[idx][:1], end_all[:-1]])
+    start_all = np.vstack([move_start[:1], end_all[:-1]])
     first = np.cumsum(counts) - counts
-    start_all[first] = previous[idx]
-    return PlannerMoves(start_all, end_all, speed[idx][owner], rows[idx][owner], idx[owner])
+    start_all[first] = move_start
+    return PlannerMoves(start_all, end_all, speed[owner], rows[owner], idx[owner])

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import ConfigError
-from ...parse.table import MOTION_RAPID
+from ...parse.table import MOTION_RAPID, NAME_ID
 from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
 from .scans import backward_min, forward_min
 
@@ -255,13 +255,13 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
 
     Examples
     --------
-    A 10 mm move at F600 with 10 mm/s^2 takes 1 s of cruise plus the ramps:
+    A 10 mm move at 8 mm/s with 10 mm/s^2: 0.8 s up, 0.45 s cruising, 0.8 s down:
 
     >>> import gcodekit
-    >>> op = gcodekit.gcode_to_operation("G21 G90\\nG1 X10 F600\\n", "grbl", plan=False)
+    >>> op = gcodekit.gcode_to_operation("G21 G90\\nG1 X10 F480\\n", "grbl", plan=False)
     >>> moves, result = plan(op, GrblConfig())
     >>> round(float(result.duration_t.sum()), 3)
-    2.0
+    2.05
     """
     moves = firmware_moves(op, None, lambda travel, angle, radius: arc_segments(travel, angle, radius,
                                                                                  config.arc_tolerance))
@@ -309,15 +309,12 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
 
 
 def _inverse_time(op: "Operation", moves: PlannerMoves) -> np.ndarray:
-    """Per move: is G93 (inverse time feed) in force?"""
-    g93 = command_rows(op, names=("feed_inverse_time",))
-    if g93.size == 0:
-        return np.zeros(len(moves), bool)
+    """Per move: is G93 (inverse time feed) in force?  (G93 is its own row before the move's.)"""
     rows = command_rows(op, names=("feed_inverse_time", "feed_per_minute", "feed_per_rev"))
-    is_g93 = np.isin(rows, g93).astype(float)
-    # the G93 word sits on the same block as its first move, so count the move's own row
-    k = np.searchsorted(rows, moves.row, side="right") - 1
-    return np.where(k >= 0, is_g93[np.maximum(k, 0)], 0.0) > 0
+    if rows.size == 0:
+        return np.zeros(len(moves), bool)
+    is_g93 = op.table.name[rows] == NAME_ID["feed_inverse_time"]
+    return in_force(moves, rows, is_g93, 0.0) > 0
 
 
 def _spindle_syncs(op: "Operation", moves: PlannerMoves, config: GrblConfig) -> np.ndarray:

@@ -1,0 +1,357 @@
+"""Emulate stage, planning: Marlin 2's lookahead, as array code.
+
+Mirrors Marlin 2.1 ``module/planner.cpp`` (``_populate_block``: feed and
+acceleration limits per axis, classic jerk or junction deviation at the
+junctions; ``reverse_pass``/``forward_pass``/``recalculate_trapezoids``
+with the ``nominal_length`` shortcut) and ``gcode/motion/G2_G3.cpp``
+(``plan_arc``: chords of ``MAX_ARC_SEGMENT_MM``, at least
+``MIN_CIRCLE_SEGMENTS`` per turn).  Marlin's variable names are kept.
+
+The program sets the limits as it goes: M201 (max acceleration per axis,
+mm/s^2), M203 (max feed rate per axis, mm/s), M204 (P print, R retract, T
+travel acceleration; S sets print and travel), M205 (X/Y/Z/E jerk, J
+junction deviation, S minimum feed rate, T minimum travel feed rate) and
+M220 (speed factor); each applies to the moves after it.
+
+Marlin comes to rest when its block buffer drains: G4, M400, G28, G29,
+M109/M190 (the queue waits for the heaters), M0/M1, M84/M18 and the end of
+the program.  The last block before a rest ends at
+``MINIMUM_PLANNER_SPEED``.
+
+Not modelled: the 16-block buffer (lookahead is unlimited), step rounding
+and ``MIN_STEPS_PER_SEGMENT`` (no steps/mm), ``SLOWDOWN`` and the minimum
+segment time (they depend on how full the buffer is), linear advance, and
+the heating times.  ``S_CURVE_ACCELERATION`` replaces each linear speed
+ramp by a Bezier ramp between the same speeds over the same time
+(``calculate_trapezoid_for_block`` keeps ``acceleration_time``), so block
+times do not change; the flag is accepted and only documents the machine.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ...errors import ConfigError
+from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
+from .grbl import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
+from .klipper import _speed_factor
+
+if TYPE_CHECKING:
+    from ..operation import Operation
+
+COS_REVERSAL = 0.999999  # planner.cpp: a junction_cos_theta above this is a full reversal
+COS_OCTAGON = -0.7071067812  # JD_HANDLE_SMALL_SEGMENTS: junctions sharper than 135 degrees
+AXES = "XYZE"
+
+#: Commands after which Marlin's block buffer drains (planner.synchronize() or a blocking wait).
+REST_NAMES = ("wait_moves", "dwell", "home", "mesh_level", "wait_hotend_temp", "wait_bed_temp",
+              "program_stop", "motors_off")
+
+
+@dataclass(frozen=True)
+class MarlinConfig:
+    """Marlin's motion settings (``Configuration.h``, ``Configuration_adv.h``, M201-M205).
+
+    Defaults are Marlin 2.1's stock configuration.  Units: mm/s, mm/s^2, mm.
+
+    Attributes
+    ----------
+    max_feedrate_x, max_feedrate_y, max_feedrate_z, max_feedrate_e : float
+        ``DEFAULT_MAX_FEEDRATE`` / M203, mm/s.
+    max_acceleration_x, ..., max_acceleration_e : float
+        ``DEFAULT_MAX_ACCELERATION`` / M201, mm/s^2.
+    acceleration, retract_acceleration, travel_acceleration : float
+        ``DEFAULT_ACCELERATION`` (M204 P), ``DEFAULT_RETRACT_ACCELERATION``
+        (M204 R, extruder-only moves), ``DEFAULT_TRAVEL_ACCELERATION``
+        (M204 T, moves without extrusion), mm/s^2.
+    classic_jerk : bool
+        ``CLASSIC_JERK``: junctions limited by per-axis jerk (M205 X/Y/Z/E)
+        instead of junction deviation (M205 J).
+    max_jerk_x, ..., max_jerk_e : float
+        ``DEFAULT_XJERK``.. ``DEFAULT_EJERK``, mm/s.
+    junction_deviation : float
+        ``JUNCTION_DEVIATION_MM``, mm.
+    jd_handle_small_segments : bool
+        ``JD_HANDLE_SMALL_SEGMENTS``: moves under 1 mm turning more than
+        135 degrees corner at the speed of the arc they approximate.
+    min_feedrate, min_travel_feedrate : float
+        ``DEFAULT_MINIMUMFEEDRATE`` (M205 S) and
+        ``DEFAULT_MINTRAVELFEEDRATE`` (M205 T), mm/s.
+    minimum_planner_speed : float
+        ``MINIMUM_PLANNER_SPEED``, mm/s: the speed at a stop.
+    s_curve_acceleration : bool
+        ``S_CURVE_ACCELERATION``; no effect on times (see the module notes).
+    max_arc_segment_mm : float
+        ``MAX_ARC_SEGMENT_MM``: arc chords are at most this long, mm.
+    min_circle_segments : int
+        ``MIN_CIRCLE_SEGMENTS``: chords in a full turn, at least.
+    """
+
+    max_feedrate_x: float = 300.0
+    max_feedrate_y: float = 300.0
+    max_feedrate_z: float = 5.0
+    max_feedrate_e: float = 25.0
+    max_acceleration_x: float = 3000.0
+    max_acceleration_y: float = 3000.0
+    max_acceleration_z: float = 100.0
+    max_acceleration_e: float = 10000.0
+    acceleration: float = 3000.0
+    retract_acceleration: float = 3000.0
+    travel_acceleration: float = 3000.0
+    classic_jerk: bool = False
+    max_jerk_x: float = 10.0
+    max_jerk_y: float = 10.0
+    max_jerk_z: float = 0.3
+    max_jerk_e: float = 5.0
+    junction_deviation: float = 0.013
+    jd_handle_small_segments: bool = True
+    min_feedrate: float = 0.0
+    min_travel_feedrate: float = 0.0
+    minimum_planner_speed: float = 0.05
+    s_curve_acceleration: bool = False
+    max_arc_segment_mm: float = 1.0
+    min_circle_segments: int = 72
+
+    def axes(self, name: str) -> tuple[float, float, float, float]:
+        """The X, Y, Z, E values of ``max_feedrate``, ``max_acceleration`` or ``max_jerk``."""
+        return tuple(float(getattr(self, f"{name}_{a.lower()}")) for a in AXES)
+
+    @classmethod
+    def from_m503(cls, path: str | os.PathLike) -> "MarlinConfig":
+        """Read the settings Marlin reports with M503 (M201, M203, M204, M205 lines).
+
+        ``echo:`` prefixes and comments are skipped; a later line overrides
+        an earlier one.  An M205 with X (and no J) means a classic-jerk
+        build, one with J a junction-deviation build.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> p = pathlib.Path(tempfile.mkdtemp()) / "m503.txt"
+        >>> _ = p.write_text("echo:  M204 P1250.00 R1250.00 T1500.00\\necho:  M205 B20000.00 S0.00 T0.00 J0.02\\n")
+        >>> c = MarlinConfig.from_m503(p)
+        >>> c.travel_acceleration, c.junction_deviation, c.classic_jerk
+        (1500.0, 0.02, False)
+        """
+        try:
+            text = open(path, encoding="utf-8").read()
+        except OSError as exc:
+            raise ConfigError(f"{path}: cannot read Marlin M503 report: {exc}") from exc
+        values: dict[str, float | bool] = {}
+        seen = False
+        for line in text.splitlines():
+            line = re.sub(r"^\s*(echo:)?\s*", "", line.split(";")[0])
+            match = re.match(r"M(20[1345])\b(.*)", line, re.IGNORECASE)
+            if not match:
+                continue
+            seen = True
+            words = {k.upper(): float(v) for k, v in re.findall(r"([A-Za-z])\s*([-+]?[\d.]+)", match.group(2))}
+            values.update(_m20x_settings(int(match.group(1)), words))
+        if not seen:
+            raise ConfigError(f"{path}: no M201/M203/M204/M205 lines (is this a Marlin M503 report?)")
+        return cls(**values)
+
+
+def _m20x_settings(code: int, words: dict[str, float]) -> dict[str, float | bool]:
+    """MarlinConfig fields set by one M201/M203/M204/M205 line (Marlin 2.1 gcode/config)."""
+    out: dict[str, float | bool] = {}
+    if code in (201, 203):
+        name = "max_acceleration" if code == 201 else "max_feedrate"
+        out.update({f"{name}_{a.lower()}": words[a] for a in AXES if a in words})
+    elif code == 204:  # M204.cpp: S is the legacy print-and-travel acceleration
+        if "S" in words:
+            out["acceleration"] = out["travel_acceleration"] = words["S"]
+        for letter, name in (("P", "acceleration"), ("R", "retract_acceleration"), ("T", "travel_acceleration")):
+            if letter in words:
+                out[name] = words[letter]
+    elif code == 205:
+        out.update({f"max_jerk_{a.lower()}": words[a] for a in AXES if a in words})
+        for letter, name in (("S", "min_feedrate"), ("T", "min_travel_feedrate"), ("J", "junction_deviation")):
+            if letter in words:
+                out[name] = words[letter]
+        if "J" in words or "X" in words:
+            out["classic_jerk"] = "X" in words and "J" not in words
+    return out
+
+
+def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray,
+                 max_arc_segment_mm: float = 1.0, min_circle_segments: int = 72) -> np.ndarray:
+    """Chords per arc as Marlin's ``plan_arc`` cuts them.
+
+    ``floor(travel / MAX_ARC_SEGMENT_MM)``, but at least
+    ``ceil(MIN_CIRCLE_SEGMENTS * angle / 2 pi)`` and at least one.
+
+    Examples
+    --------
+    >>> arc_segments(np.array([31.4159]), np.array([np.pi]), np.array([10.0]))
+    array([36.])
+    """
+    by_length = np.floor(travel_d / max_arc_segment_mm)
+    by_angle = np.ceil(min_circle_segments * np.abs(angle) / (2.0 * np.pi) - 1e-9)
+    return np.maximum(np.maximum(by_length, by_angle), 1.0)
+
+
+def settings_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray, letter: str,
+                      initial: float, scale: float = 1.0) -> np.ndarray:
+    """Per move, the last value of word ``letter`` among ``rows`` before it (``initial`` before any)."""
+    values = op.table.param(letter)[rows] * scale
+    given = ~np.isnan(values)
+    return in_force(moves, rows[given], values[given], initial)
+
+
+def _program_limits(op: "Operation", moves: PlannerMoves, config: MarlinConfig) -> dict[str, np.ndarray]:
+    """Per move, the limits in force: the config's, then M201/M203/M204/M205 in the program."""
+    m201 = command_rows(op, names=("set_max_accel",))
+    m203 = command_rows(op, names=("set_max_feed",))
+    m204 = command_rows(op, names=("set_accel",))
+    m205 = command_rows(op, names=("set_jerk",))
+
+    def per_axis(rows, name):
+        return np.column_stack([settings_in_force(op, moves, rows, a, v) for a, v in zip(AXES, config.axes(name))])
+
+    limits = {
+        "max_acceleration": per_axis(m201, "max_acceleration"),
+        "max_feedrate": per_axis(m203, "max_feedrate"),
+        "max_jerk": per_axis(m205, "max_jerk"),
+        "retract_acceleration": settings_in_force(op, moves, m204, "R", config.retract_acceleration),
+        "junction_deviation": settings_in_force(op, moves, m205, "J", config.junction_deviation),
+        "min_feedrate": settings_in_force(op, moves, m205, "S", config.min_feedrate),
+        "min_travel_feedrate": settings_in_force(op, moves, m205, "T", config.min_travel_feedrate),
+    }
+    # M204.cpp: S sets print and travel acceleration, then P and T override it
+    t = op.table
+    s_word = t.param("S")[m204]
+    for letter, name in (("P", "acceleration"), ("T", "travel_acceleration")):
+        word = t.param(letter)[m204]
+        value = np.where(np.isnan(word), s_word, word)
+        given = ~np.isnan(value)
+        limits[name] = in_force(moves, m204[given], value[given], getattr(config, name))
+    return limits
+
+
+def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResult]:
+    """Plan an emulated operation as Marlin 2 would; one result per firmware move.
+
+    Examples
+    --------
+    A 100 mm move at 50 mm/s with 1000 mm/s^2 and 10 mm/s jerk starts and
+    ends at 10 mm/s: 0.04 s on each ramp and 96 mm cruising:
+
+    >>> import gcodekit
+    >>> op = gcodekit.gcode_to_operation("M204 P1000\\nG1 X100 E5 F3000\\n", "marlin", plan=False)
+    >>> moves, result = plan(op, MarlinConfig(classic_jerk=True))
+    >>> round(float(result.start_v[0]), 3), round(float(result.duration_t[0]), 4)
+    (10.0, 2.0)
+    """
+    factor = _speed_factor(op)
+    moves = firmware_moves(op, factor, lambda travel, angle, radius: arc_segments(
+        travel, angle, radius, config.max_arc_segment_mm, config.min_circle_segments))
+    n = len(moves)
+    if n == 0:
+        return moves, empty_result()
+    lim = _program_limits(op, moves, config)
+    dist_mm = moves.axes_d
+
+    # _populate_block: length, nominal speed and per-axis speeds
+    xyz_moves = np.any(dist_mm[:, :3] != 0, axis=1)
+    esteps = dist_mm[:, 3] != 0
+    xyz_mm, _ = unit_vectors(dist_mm[:, :3])
+    millimeters = np.where(xyz_moves, xyz_mm, np.abs(dist_mm[:, 3]))
+    fr_mm_s = np.maximum(np.nan_to_num(moves.speed_v), np.where(esteps, lim["min_feedrate"], lim["min_travel_feedrate"]))
+    fr_mm_s = np.maximum(fr_mm_s, config.minimum_planner_speed)  # a move without a feed rate still moves
+    inverse_millimeters = 1.0 / millimeters
+    current_speed = dist_mm * (inverse_millimeters * fr_mm_s)[:, None]
+    speed_factor = np.minimum(limit_by_axis_maximum(lim["max_feedrate"], current_speed), 1.0)
+    nominal_speed = fr_mm_s * speed_factor
+    current_speed *= speed_factor[:, None]
+
+    # acceleration: retract for extruder-only moves, else print or travel, capped per axis
+    accel = np.where(esteps, lim["acceleration"], lim["travel_acceleration"])
+    with np.errstate(divide="ignore"):
+        axis_cap = np.where(dist_mm != 0, lim["max_acceleration"] * millimeters[:, None] / np.abs(dist_mm), np.inf)
+    acceleration = np.where(xyz_moves, np.minimum(accel, axis_cap.min(axis=1)), lim["retract_acceleration"])
+
+    rest_before = happens_before(moves, command_rows(op, names=REST_NAMES))
+    rest_before[0] = True
+    prev = np.r_[0, np.arange(n - 1)]
+    minimum_planner_speed_sqr = config.minimum_planner_speed**2
+    if config.classic_jerk:
+        vmax_junction = _classic_jerk(current_speed, nominal_speed, lim["max_jerk"], prev, rest_before)
+        max_entry_speed_sqr = vmax_junction**2
+    else:
+        max_entry_speed_sqr = _junction_deviation(dist_mm, esteps, millimeters, nominal_speed, acceleration,
+                                                  lim, prev, config)
+        max_entry_speed_sqr[rest_before] = minimum_planner_speed_sqr
+
+    delta_v2 = 2.0 * acceleration * millimeters
+    # "If a block can de/ac-celerate from nominal speed to zero within the length of the block, then the
+    # current block and next block junction speeds are guaranteed to always be at their maximum"
+    nominal_length = nominal_speed**2 <= minimum_planner_speed_sqr + delta_v2
+    rest_after = np.r_[rest_before[1:], True]
+    entry_speed_sqr, exit_speed_sqr = lookahead(max_entry_speed_sqr, delta_v2, rest_after,
+                                                rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
+    return moves, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed**2, exit_speed_sqr)
+
+
+def _classic_jerk(current_speed, nominal_speed, max_jerk, prev, rest_before) -> np.ndarray:
+    """``vmax_junction`` per move, Marlin 2.1 CLASSIC_JERK ("adapted from Prusa firmware").
+
+    The per-axis loops become array code: for ``safe_speed`` the first
+    limited axis scales the nominal speed by ``maxj / jerk`` and each later
+    one only lowers it, so the result is the nominal speed times the
+    smallest ``maxj / jerk``; for the junction, each limiting axis sets
+    ``v_factor = maxj / jerk`` (its jerk being measured at the running
+    ``v_factor``), so again the smallest ratio wins.
+    """
+    speed = np.abs(current_speed)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        limited = np.where(speed > max_jerk, max_jerk / speed, 1.0)
+    safe_speed = nominal_speed * limited.min(axis=1)
+
+    # The junction speed is shared: the smaller nominal speed, the previous block's axis speeds scaled to it.
+    previous_nominal_speed = nominal_speed[prev]
+    vmax_junction = np.minimum(nominal_speed, previous_nominal_speed)
+    v_exit = current_speed[prev] * (vmax_junction / previous_nominal_speed)[:, None]
+    v_entry = current_speed
+    # coasting (same direction) or axis reversal
+    jerk = np.where(v_exit > v_entry,
+                    np.where((v_entry > 0) | (v_exit < 0), v_exit - v_entry, np.maximum(v_exit, -v_entry)),
+                    np.where((v_entry < 0) | (v_exit > 0), v_entry - v_exit, np.maximum(-v_exit, v_entry)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_factor = np.where(jerk > max_jerk, max_jerk / jerk, 1.0).min(axis=1)
+    vmax_junction = vmax_junction * v_factor
+    # "Not coasting. The machine will stop and start the movements anyway, better to start the segment from start."
+    vmax_junction_threshold = vmax_junction * 0.99
+    restart = (safe_speed[prev] > vmax_junction_threshold) & (safe_speed > vmax_junction_threshold)
+    return np.where(rest_before | restart, safe_speed, vmax_junction)
+
+
+def _junction_deviation(dist_mm, esteps, millimeters, nominal_speed, acceleration, lim, prev,
+                        config: MarlinConfig) -> np.ndarray:
+    """``vmax_junction_sqr`` per move, Marlin 2.1 junction deviation (with JD_HANDLE_SMALL_SEGMENTS)."""
+    # unit vectors: XYZ over the XYZ length; with extrusion, normalised with E (normalize_junction_vector)
+    unit_vec = dist_mm / millimeters[:, None]
+    unit_vec[:, 3] = 0.0
+    _, with_e = unit_vectors(dist_mm)
+    unit_vec = np.where(esteps[:, None], with_e, unit_vec)
+    prev_unit_vec = unit_vec[prev]
+    junction_cos_theta = -np.einsum("ij,ij->i", prev_unit_vec, unit_vec)
+    _, junction_unit_vec = unit_vectors(unit_vec - prev_unit_vec)
+    junction_acceleration = np.minimum(acceleration, limit_by_axis_maximum(lim["max_acceleration"], junction_unit_vec))
+    cos_theta = np.maximum(junction_cos_theta, -COS_REVERSAL)  # round-off guard: no division by zero
+    sin_theta_d2 = np.sqrt(0.5 * (1.0 - cos_theta))
+    vmax_junction_sqr = junction_acceleration * lim["junction_deviation"] * sin_theta_d2 / (1.0 - sin_theta_d2)
+    if config.jd_handle_small_segments:
+        # "For small moves with >135deg junction (octagon) find speed for approximate arc"
+        small = (millimeters < 1.0) & (junction_cos_theta < COS_OCTAGON)
+        junction_theta = np.arccos(np.clip(-junction_cos_theta, -1.0, 1.0))
+        with np.errstate(divide="ignore"):
+            arc_sqr = np.where(small, millimeters * junction_acceleration / junction_theta, np.inf)
+        vmax_junction_sqr = np.minimum(vmax_junction_sqr, arc_sqr)
+    vmax_junction_sqr = np.where(junction_cos_theta > COS_REVERSAL, config.minimum_planner_speed**2, vmax_junction_sqr)
+    return np.minimum(vmax_junction_sqr, np.minimum(nominal_speed, nominal_speed[prev]) ** 2)
