@@ -13,7 +13,8 @@ import gcodekit
 
 
 def run(text: str, machine: str = "linuxcnc", **kw):
-    op = gcodekit.gcode_to_operation(text, machine, **kw)
+    """Emulate without the motion planner: times here are length over feed."""
+    op = gcodekit.gcode_to_operation(text, machine, plan=False, **kw)
     return op, op.to_dataframe()
 
 

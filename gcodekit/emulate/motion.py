@@ -339,7 +339,7 @@ class SCurve(SegmentProfile):
         peak_v[direct] = low_v[direct]
         up_j, up_c = self._ramp(peak_v - start_v, accel, jerk)
         down_j, down_c = self._ramp(peak_v - end_v, accel, jerk)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             cruise_d = move_d - ramps_d(peak_v)
             cruise_t = np.where(~direct & (cruise_d > 0), cruise_d / peak_v, 0.0)
             # the one ramp that does not fit the jerk limit: pure jerk phases, no constant accel

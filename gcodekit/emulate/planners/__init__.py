@@ -79,12 +79,13 @@ def apply_plan(op: "Operation", moves: PlannerMoves, result: PlanResult) -> None
     end_v = np.zeros(n)
     cruise_v = np.zeros(n)
     accel = np.zeros(n)
-    first = np.r_[True, moves.waypoint[1:] != moves.waypoint[:-1]]
-    last = np.r_[moves.waypoint[1:] != moves.waypoint[:-1], True]
-    start_v[moves.waypoint[first]] = result.start_v[first]
-    end_v[moves.waypoint[last]] = result.end_v[last]
-    np.maximum.at(cruise_v, moves.waypoint, result.cruise_v)
-    accel[moves.waypoint[first]] = result.accel[first]
+    if len(moves):
+        first = np.r_[True, moves.waypoint[1:] != moves.waypoint[:-1]]
+        last = np.r_[moves.waypoint[1:] != moves.waypoint[:-1], True]
+        start_v[moves.waypoint[first]] = result.start_v[first]
+        end_v[moves.waypoint[last]] = result.end_v[last]
+        np.maximum.at(cruise_v, moves.waypoint, result.cruise_v)
+        accel[moves.waypoint[first]] = result.accel[first]
     w.update(start_v=start_v, cruise_v=cruise_v, end_v=end_v, accel=accel)
     op.plan = (moves, result)
     op._elapsed = None

@@ -131,12 +131,19 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray, ar
     return np.maximum(np.nan_to_num(segments, nan=1.0, posinf=1.0), 1.0)
 
 
-def limit_by_axis_maximum(max_value: np.ndarray, unit_vec: np.ndarray) -> np.ndarray:
-    """grbl's ``limit_value_by_axis_maximum``: the largest value along ``unit_vec``
-    whose component on every axis stays within that axis's limit (per row)."""
-    with np.errstate(divide="ignore"):
-        ratio = np.where(unit_vec != 0, max_value / np.abs(np.where(unit_vec != 0, unit_vec, 1.0)), np.inf)
-    return ratio.min(axis=1)
+def limit_by_axis_maximum(max_value, unit_vec) -> np.ndarray:
+    """grbl's ``limit_value_by_axis_maximum``: per row, the largest value along
+    ``unit_vec`` whose component on every axis stays within that axis's limit.
+
+    ``max_value`` holds one limit per axis (a number, or an array with one
+    value per row); ``unit_vec`` is a sequence of per-axis columns.
+    """
+    limit = np.full(np.shape(unit_vec[0]), np.inf)
+    for cap, u in zip(max_value, unit_vec):
+        u = np.abs(u)
+        ratio = np.divide(cap, u, out=np.full(u.shape, np.inf), where=u > 0)
+        np.minimum(limit, ratio, out=limit)
+    return limit
 
 
 # -- the passes and the trapezoid, shared with marlin.py and reprapfirmware.py ---------
@@ -230,12 +237,11 @@ def empty_result() -> PlanResult:
     return PlanResult(empty, empty, empty, empty, empty, empty, empty)
 
 
-def unit_vectors(axes_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Lengths and unit vectors of the rows of ``axes_d`` (zero rows stay zero)."""
-    move_d = np.sqrt(np.einsum("ij,ij->i", axes_d, axes_d))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        unit = np.where(move_d[:, None] > 0, axes_d / move_d[:, None], 0.0)
-    return move_d, unit
+def unit_vectors(columns) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Length and unit-vector columns of the vectors given as per-axis columns (zero vectors stay zero)."""
+    length = np.sqrt(sum(c * c for c in columns))
+    inverse = np.divide(1.0, length, out=np.zeros_like(length), where=length > 0)
+    return length, [c * inverse for c in columns]
 
 
 # -- grbl ---------------------------------------------------------------------------
@@ -269,8 +275,9 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
     if n == 0:
         return moves, empty_result()
     w = op.waypoints
-    axes_d = moves.axes_d[:, :3]
-    move_d, unit_vec = unit_vectors(axes_d)
+    axes_d = moves.axes_d
+    move_d, unit_vec = unit_vectors([axes_d[:, a] for a in range(3)])
+    del axes_d
 
     # plan_buffer_line: the limits along the move's direction
     acceleration = limit_by_axis_maximum(config.acceleration, unit_vec)
@@ -290,8 +297,8 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
 
     # junction: grbl planner.c, "Compute maximum allowable entry speed at junction by centripetal acceleration"
     prev = np.r_[0, np.arange(n - 1)]
-    junction_cos_theta = -np.einsum("ij,ij->i", unit_vec[prev], unit_vec)
-    _, junction_unit_vec = unit_vectors(unit_vec - unit_vec[prev])
+    junction_cos_theta = -sum(u[prev] * u for u in unit_vec)
+    _, junction_unit_vec = unit_vectors([u - u[prev] for u in unit_vec])
     junction_acceleration = limit_by_axis_maximum(config.acceleration, junction_unit_vec)
     sin_theta_d2 = np.sqrt(np.clip(0.5 * (1.0 - junction_cos_theta), 0.0, 1.0))
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -197,22 +197,32 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray,
 
 
 def settings_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray, letter: str,
-                      initial: float, scale: float = 1.0) -> np.ndarray:
-    """Per move, the last value of word ``letter`` among ``rows`` before it (``initial`` before any)."""
+                      initial: float, scale: float = 1.0) -> np.ndarray | float:
+    """Per move, the last value of word ``letter`` among ``rows`` before it (``initial`` before any).
+
+    A number when one value holds for every move (the common case: the
+    limits are set once at the top), else an array.
+    """
     values = op.table.param(letter)[rows] * scale
     given = ~np.isnan(values)
-    return in_force(moves, rows[given], values[given], initial)
+    if not given.any():
+        return float(initial)
+    per_move = in_force(moves, rows[given], values[given], initial)
+    return float(per_move[0]) if per_move.min() == per_move.max() else per_move
 
 
-def _program_limits(op: "Operation", moves: PlannerMoves, config: MarlinConfig) -> dict[str, np.ndarray]:
-    """Per move, the limits in force: the config's, then M201/M203/M204/M205 in the program."""
+def _program_limits(op: "Operation", moves: PlannerMoves, config: MarlinConfig) -> dict:
+    """Per move, the limits in force: the config's, then M201/M203/M204/M205 in the program.
+
+    Per-axis limits are lists of four (X, Y, Z, E), each a number or an array.
+    """
     m201 = command_rows(op, names=("set_max_accel",))
     m203 = command_rows(op, names=("set_max_feed",))
     m204 = command_rows(op, names=("set_accel",))
     m205 = command_rows(op, names=("set_jerk",))
 
     def per_axis(rows, name):
-        return np.column_stack([settings_in_force(op, moves, rows, a, v) for a, v in zip(AXES, config.axes(name))])
+        return [settings_in_force(op, moves, rows, a, v) for a, v in zip(AXES, config.axes(name))]
 
     limits = {
         "max_acceleration": per_axis(m201, "max_acceleration"),
@@ -239,14 +249,14 @@ def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResul
 
     Examples
     --------
-    A 100 mm move at 50 mm/s with 1000 mm/s^2 and 10 mm/s jerk starts and
-    ends at 10 mm/s: 0.04 s on each ramp and 96 mm cruising:
+    A 100 mm move at 50 mm/s, 1000 mm/s^2 and 10 mm/s jerk starts at 10 mm/s
+    (the jerk) and brakes to a stop (``MINIMUM_PLANNER_SPEED``):
 
     >>> import gcodekit
     >>> op = gcodekit.gcode_to_operation("M204 P1000\\nG1 X100 E5 F3000\\n", "marlin", plan=False)
     >>> moves, result = plan(op, MarlinConfig(classic_jerk=True))
     >>> round(float(result.start_v[0]), 3), round(float(result.duration_t[0]), 4)
-    (10.0, 2.0)
+    (10.0, 2.041)
     """
     factor = _speed_factor(op)
     moves = firmware_moves(op, factor, lambda travel, angle, radius: arc_segments(
@@ -255,93 +265,99 @@ def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResul
     if n == 0:
         return moves, empty_result()
     lim = _program_limits(op, moves, config)
-    dist_mm = moves.axes_d
+    axes_d = moves.axes_d
+    dist_mm = [np.ascontiguousarray(axes_d[:, a]) for a in range(4)]  # X, Y, Z, E columns
+    del axes_d
 
     # _populate_block: length, nominal speed and per-axis speeds
-    xyz_moves = np.any(dist_mm[:, :3] != 0, axis=1)
-    esteps = dist_mm[:, 3] != 0
-    xyz_mm, _ = unit_vectors(dist_mm[:, :3])
-    millimeters = np.where(xyz_moves, xyz_mm, np.abs(dist_mm[:, 3]))
+    xyz_moves = (dist_mm[0] != 0) | (dist_mm[1] != 0) | (dist_mm[2] != 0)
+    esteps = dist_mm[3] != 0
+    xyz_mm, _ = unit_vectors(dist_mm[:3])
+    millimeters = np.where(xyz_moves, xyz_mm, np.abs(dist_mm[3]))
+    del xyz_mm
     fr_mm_s = np.maximum(np.nan_to_num(moves.speed_v), np.where(esteps, lim["min_feedrate"], lim["min_travel_feedrate"]))
     fr_mm_s = np.maximum(fr_mm_s, config.minimum_planner_speed)  # a move without a feed rate still moves
     inverse_millimeters = 1.0 / millimeters
-    current_speed = dist_mm * (inverse_millimeters * fr_mm_s)[:, None]
-    speed_factor = np.minimum(limit_by_axis_maximum(lim["max_feedrate"], current_speed), 1.0)
+    # speed_factor: the largest fraction of fr_mm_s within every axis's max feed rate
+    speed_factor = np.minimum(limit_by_axis_maximum(lim["max_feedrate"], dist_mm) * millimeters / fr_mm_s, 1.0)
     nominal_speed = fr_mm_s * speed_factor
-    current_speed *= speed_factor[:, None]
+    del speed_factor, fr_mm_s
+    # current_speed[i] = dist_mm[i] * inverse_secs, after the speed factor
+    speed_per_mm = nominal_speed * inverse_millimeters
 
     # acceleration: retract for extruder-only moves, else print or travel, capped per axis
     accel = np.where(esteps, lim["acceleration"], lim["travel_acceleration"])
-    with np.errstate(divide="ignore"):
-        axis_cap = np.where(dist_mm != 0, lim["max_acceleration"] * millimeters[:, None] / np.abs(dist_mm), np.inf)
-    acceleration = np.where(xyz_moves, np.minimum(accel, axis_cap.min(axis=1)), lim["retract_acceleration"])
+    accel = np.minimum(accel, limit_by_axis_maximum(lim["max_acceleration"], dist_mm) * millimeters)
+    acceleration = np.where(xyz_moves, accel, lim["retract_acceleration"])
+    del accel
 
     rest_before = happens_before(moves, command_rows(op, names=REST_NAMES))
     rest_before[0] = True
     prev = np.r_[0, np.arange(n - 1)]
     minimum_planner_speed_sqr = config.minimum_planner_speed**2
     if config.classic_jerk:
-        vmax_junction = _classic_jerk(current_speed, nominal_speed, lim["max_jerk"], prev, rest_before)
-        max_entry_speed_sqr = vmax_junction**2
+        vmax_junction = _classic_jerk(dist_mm, speed_per_mm, nominal_speed, lim["max_jerk"], prev, rest_before)
+        max_entry_speed_sqr = vmax_junction * vmax_junction
     else:
-        max_entry_speed_sqr = _junction_deviation(dist_mm, esteps, millimeters, nominal_speed, acceleration,
-                                                  lim, prev, config)
+        max_entry_speed_sqr = _junction_deviation(dist_mm, esteps, inverse_millimeters, millimeters, nominal_speed,
+                                                  acceleration, lim, prev, config)
         max_entry_speed_sqr[rest_before] = minimum_planner_speed_sqr
+    del dist_mm
 
     delta_v2 = 2.0 * acceleration * millimeters
+    nominal_speed_sqr = nominal_speed * nominal_speed
     # "If a block can de/ac-celerate from nominal speed to zero within the length of the block, then the
     # current block and next block junction speeds are guaranteed to always be at their maximum"
-    nominal_length = nominal_speed**2 <= minimum_planner_speed_sqr + delta_v2
+    nominal_length = nominal_speed_sqr <= minimum_planner_speed_sqr + delta_v2
     rest_after = np.r_[rest_before[1:], True]
     entry_speed_sqr, exit_speed_sqr = lookahead(max_entry_speed_sqr, delta_v2, rest_after,
                                                 rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
-    return moves, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed**2, exit_speed_sqr)
+    return moves, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr)
 
 
-def _classic_jerk(current_speed, nominal_speed, max_jerk, prev, rest_before) -> np.ndarray:
+def _classic_jerk(dist_mm, speed_per_mm, nominal_speed, max_jerk, prev, rest_before) -> np.ndarray:
     """``vmax_junction`` per move, Marlin 2.1 CLASSIC_JERK ("adapted from Prusa firmware").
 
-    The per-axis loops become array code: for ``safe_speed`` the first
-    limited axis scales the nominal speed by ``maxj / jerk`` and each later
-    one only lowers it, so the result is the nominal speed times the
-    smallest ``maxj / jerk``; for the junction, each limiting axis sets
-    ``v_factor = maxj / jerk`` (its jerk being measured at the running
-    ``v_factor``), so again the smallest ratio wins.
+    The per-axis loops keep their shape; only the moves are vectorized.
+    For ``safe_speed`` the first limited axis scales the nominal speed by
+    ``maxj / jerk`` and each later one only lowers it, so the result is the
+    nominal speed times the smallest ``maxj / jerk``; at the junction each
+    limiting axis sets ``v_factor = maxj / jerk`` (its jerk measured at the
+    running ``v_factor``), so again the smallest ratio wins.
     """
-    speed = np.abs(current_speed)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        limited = np.where(speed > max_jerk, max_jerk / speed, 1.0)
-    safe_speed = nominal_speed * limited.min(axis=1)
-
     # The junction speed is shared: the smaller nominal speed, the previous block's axis speeds scaled to it.
     previous_nominal_speed = nominal_speed[prev]
     vmax_junction = np.minimum(nominal_speed, previous_nominal_speed)
-    v_exit = current_speed[prev] * (vmax_junction / previous_nominal_speed)[:, None]
-    v_entry = current_speed
-    # coasting (same direction) or axis reversal
-    jerk = np.where(v_exit > v_entry,
-                    np.where((v_entry > 0) | (v_exit < 0), v_exit - v_entry, np.maximum(v_exit, -v_entry)),
-                    np.where((v_entry < 0) | (v_exit > 0), v_entry - v_exit, np.maximum(-v_exit, v_entry)))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        v_factor = np.where(jerk > max_jerk, max_jerk / jerk, 1.0).min(axis=1)
-    vmax_junction = vmax_junction * v_factor
+    exit_scale = speed_per_mm[prev] * (vmax_junction / previous_nominal_speed)
+    safe_factor = np.ones_like(nominal_speed)
+    v_factor = np.ones_like(nominal_speed)
+    for d, maxj in zip(dist_mm, max_jerk):
+        v_entry = d * speed_per_mm  # current_speed[axis]
+        v_exit = d[prev] * exit_scale  # previous_speed[axis], scaled to vmax_junction
+        cs = np.abs(v_entry)
+        np.minimum(safe_factor, np.divide(maxj, cs, out=np.ones_like(cs), where=cs > maxj), out=safe_factor)
+        # coasting (same direction) or axis reversal
+        jerk = np.where(v_exit > v_entry,
+                        np.where((v_entry > 0) | (v_exit < 0), v_exit - v_entry, np.maximum(v_exit, -v_entry)),
+                        np.where((v_entry < 0) | (v_exit > 0), v_entry - v_exit, np.maximum(-v_exit, v_entry)))
+        np.minimum(v_factor, np.divide(maxj, jerk, out=np.ones_like(jerk), where=jerk > maxj), out=v_factor)
+    safe_speed = nominal_speed * safe_factor
+    vmax_junction *= v_factor
     # "Not coasting. The machine will stop and start the movements anyway, better to start the segment from start."
     vmax_junction_threshold = vmax_junction * 0.99
     restart = (safe_speed[prev] > vmax_junction_threshold) & (safe_speed > vmax_junction_threshold)
     return np.where(rest_before | restart, safe_speed, vmax_junction)
 
 
-def _junction_deviation(dist_mm, esteps, millimeters, nominal_speed, acceleration, lim, prev,
+def _junction_deviation(dist_mm, esteps, inverse_millimeters, millimeters, nominal_speed, acceleration, lim, prev,
                         config: MarlinConfig) -> np.ndarray:
     """``vmax_junction_sqr`` per move, Marlin 2.1 junction deviation (with JD_HANDLE_SMALL_SEGMENTS)."""
     # unit vectors: XYZ over the XYZ length; with extrusion, normalised with E (normalize_junction_vector)
-    unit_vec = dist_mm / millimeters[:, None]
-    unit_vec[:, 3] = 0.0
     _, with_e = unit_vectors(dist_mm)
-    unit_vec = np.where(esteps[:, None], with_e, unit_vec)
-    prev_unit_vec = unit_vec[prev]
-    junction_cos_theta = -np.einsum("ij,ij->i", prev_unit_vec, unit_vec)
-    _, junction_unit_vec = unit_vectors(unit_vec - prev_unit_vec)
+    unit_vec = [np.where(esteps, u, d * inverse_millimeters) for u, d in zip(with_e[:3], dist_mm[:3])]
+    unit_vec.append(with_e[3])
+    junction_cos_theta = -sum(u[prev] * u for u in unit_vec)
+    _, junction_unit_vec = unit_vectors([u - u[prev] for u in unit_vec])
     junction_acceleration = np.minimum(acceleration, limit_by_axis_maximum(lim["max_acceleration"], junction_unit_vec))
     cos_theta = np.maximum(junction_cos_theta, -COS_REVERSAL)  # round-off guard: no division by zero
     sin_theta_d2 = np.sqrt(0.5 * (1.0 - cos_theta))
@@ -350,8 +366,8 @@ def _junction_deviation(dist_mm, esteps, millimeters, nominal_speed, acceleratio
         # "For small moves with >135deg junction (octagon) find speed for approximate arc"
         small = (millimeters < 1.0) & (junction_cos_theta < COS_OCTAGON)
         junction_theta = np.arccos(np.clip(-junction_cos_theta, -1.0, 1.0))
-        with np.errstate(divide="ignore"):
-            arc_sqr = np.where(small, millimeters * junction_acceleration / junction_theta, np.inf)
+        arc_sqr = np.divide(millimeters * junction_acceleration, junction_theta,
+                            out=np.full_like(millimeters, np.inf), where=small)
         vmax_junction_sqr = np.minimum(vmax_junction_sqr, arc_sqr)
     vmax_junction_sqr = np.where(junction_cos_theta > COS_REVERSAL, config.minimum_planner_speed**2, vmax_junction_sqr)
     return np.minimum(vmax_junction_sqr, np.minimum(nominal_speed, nominal_speed[prev]) ** 2)
