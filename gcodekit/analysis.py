@@ -175,7 +175,7 @@ def velocity_profile(op: "Operation") -> "pd.DataFrame":
     """
     import pandas as pd
 
-    plan = getattr(op, "plan", None)
+    plan = op.plan
     if plan is None:
         w = op.waypoints
         moved = np.flatnonzero(w["motion"] > 0)

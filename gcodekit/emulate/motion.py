@@ -56,6 +56,8 @@ MIN_MOVE_D = 1e-9
 #: Bisection steps that find an S-curve's peak speed: each halves the
 #: interval, so 64 reach the last bit of a float.
 _BISECT_STEPS = 64
+#: Doublings of a trial peak speed from 1 mm/s: enough to pass the largest float.
+_DOUBLING_STEPS = 1100
 
 
 class SegmentTiming(NamedTuple):
@@ -328,7 +330,9 @@ class SCurve(SegmentProfile):
                                                                  end_v[lower], accel[lower]).cruise_v)
             grow = ~np.isfinite(hi)
             hi[grow] = np.maximum(lo[grow], 1.0)
-            while grow.any():  # no acceleration limit either: double until the ramps overshoot
+            for _ in range(_DOUBLING_STEPS):  # no acceleration limit: double until the ramps overshoot
+                if not grow.any():
+                    break
                 grow[grow] = ramps_d(hi[grow], lower[grow]) <= move_d[lower[grow]]
                 hi[grow] *= 2.0
             for _ in range(_BISECT_STEPS):
@@ -419,7 +423,8 @@ class MotionProfile:
     Examples
     --------
     Two 10 mm moves meeting at a right angle slow to the corner speed
-    ``sqrt(a * d * s / (1 - s))`` with ``s = sin(45 deg)``:
+    ``sqrt(max_acceleration * junction_deviation * s / (1 - s))``, ``s =
+    sin(45 deg)``:
 
     >>> import numpy as np
     >>> from gcodekit.emulate.planners.base import PlannerMoves
@@ -550,13 +555,14 @@ class MotionProfile:
             # Junction k is the start of move k; junction n the end of the last move.
             cap_v2 = np.r_[0.0, junction_v2]
             inc_v2 = np.r_[delta_v2, 0.0]
-            # Forward pass, the loop
+            # Forward pass from rest, the loop
             #     v2[0] = 0; for i in range(n): v2[i + 1] = min(cap_v2[i + 1], v2[i] + delta_v2[i])
-            # is a running minimum of cap_v2 - cumsum(delta_v2) (scans.forward_min).
+            # With S[k] = delta_v2[0] + ... + delta_v2[k - 1], v2[k] - S[k] = min(cap_v2[k] - S[k],
+            # v2[k - 1] - S[k - 1]): a running minimum (scans.forward_min).
             reach_v2 = forward_min(cap_v2, inc_v2)
             # Backward pass from the final stop, the loop
             #     v2[n] = 0; for i in reversed(range(n)): v2[i] = min(reach_v2[i], v2[i + 1] + delta_v2[i])
-            # is the same running minimum taken from the end (scans.backward_min).
+            # is the same running minimum with sums taken from the end (scans.backward_min).
             v2 = backward_min(reach_v2, inc_v2, 0.0)
             start_v, end_v = np.sqrt(v2[:-1]), np.sqrt(v2[1:])
             timing = self.segment_profile().timing(move_d, start_v, cruise_v, end_v, accel)

@@ -149,6 +149,7 @@ class Operation:
         self.diagnostics = diagnostics if diagnostics is not None else Diagnostics(file)
         self.n_lines = n_lines
         self._elapsed: np.ndarray | None = None
+        self.plan = None  # (PlannerMoves, PlanResult) once a motion planner has run
 
     # -- the seed's object API ---------------------------------------------------
 
@@ -287,9 +288,10 @@ class Operation:
         for key in SMALL_COLUMNS:
             data[key] = w[key]
         data["motion"] = pd.Categorical.from_codes(w["motion"], categories=["none", *MOTION_NAMES[1:]])
-        for key in ("start_v", "cruise_v", "end_v", "accel"):
-            if key in w:
-                data[key] = w[key]
+        if getattr(self, "plan", None) is not None:
+            from .planners import waypoint_speeds
+
+            data.update(waypoint_speeds(self))
         data["elapsed_time"] = self.elapsed_time()
         return pd.DataFrame(data, copy=False)
 
@@ -347,9 +349,12 @@ class Operation:
         frame["units"] = np.where(inch, "in", "mm")
         frame["time"] = w["time"][moved]
         frame["t_end"] = self.elapsed_time()[moved]
-        if "cruise_v" in w:  # planned by the machine's firmware model, mm/s
-            for key in ("start_v", "cruise_v", "end_v"):
-                frame[key] = w[key][moved] * scale
+        if getattr(self, "plan", None) is not None:  # planned by the machine's firmware model
+            from .planners import waypoint_speeds
+
+            for key, values in waypoint_speeds(self).items():
+                if key != "accel":
+                    frame[key] = values[moved] * scale
         return pd.DataFrame(frame)
 
 

@@ -25,6 +25,9 @@ if TYPE_CHECKING:
 #: Planner name -> (module, settings class, reader of the firmware's own config file)
 PLANNERS = {
     "klipper": ("gcodekit.emulate.planners.klipper", "KlipperConfig", "from_printer_cfg"),
+    "marlin": ("gcodekit.emulate.planners.marlin", "MarlinConfig", "from_m503"),
+    "grbl": ("gcodekit.emulate.planners.grbl", "GrblConfig", "from_settings"),
+    "reprapfirmware": ("gcodekit.emulate.planners.reprapfirmware", "RrfConfig", "from_config_g"),
     "motion_profile": ("gcodekit.emulate.planners.motion_profile", "MotionProfileConfig", "from_config_file"),
 }
 
@@ -64,28 +67,32 @@ def run_planner(op: "Operation", name: str, settings) -> "Operation":
 
 
 def apply_plan(op: "Operation", moves: PlannerMoves, result: PlanResult) -> None:
-    """Per-waypoint planned time and speeds from per-move results.
+    """Per-waypoint planned time from per-move results.
 
     A waypoint's ``time`` becomes the sum of its moves' durations (dwells
-    keep theirs); ``start_v`` is its first move's entry speed, ``end_v`` its
-    last move's exit speed, ``cruise_v`` the fastest cruise among its moves.
+    keep theirs); the per-move plan stays in ``op.plan`` and
+    :func:`waypoint_speeds` gives each waypoint's entry, cruise and exit speed.
     """
     w = op.waypoints
     n = w["x"].size
     planned = np.bincount(moves.waypoint, weights=result.duration_t, minlength=n)
     has_moves = np.bincount(moves.waypoint, minlength=n) > 0
     w["time"] = np.where(has_moves, planned, np.where(w["motion"] > 0, 0.0, w["time"]))
-    start_v = np.zeros(n)
-    end_v = np.zeros(n)
-    cruise_v = np.zeros(n)
-    accel = np.zeros(n)
+    op.plan = (moves, result)
+    op._elapsed = None
+
+
+def waypoint_speeds(op: "Operation") -> dict[str, np.ndarray]:
+    """Planned ``start_v`` (first move's entry), ``cruise_v`` (fastest cruise),
+    ``end_v`` (last move's exit) and ``accel`` of every waypoint, mm/s and mm/s^2."""
+    moves, result = op.plan
+    n = op.waypoints["x"].size
+    out = {k: np.zeros(n) for k in ("start_v", "cruise_v", "end_v", "accel")}
     if len(moves):
         first = np.r_[True, moves.waypoint[1:] != moves.waypoint[:-1]]
         last = np.r_[moves.waypoint[1:] != moves.waypoint[:-1], True]
-        start_v[moves.waypoint[first]] = result.start_v[first]
-        end_v[moves.waypoint[last]] = result.end_v[last]
-        np.maximum.at(cruise_v, moves.waypoint, result.cruise_v)
-        accel[moves.waypoint[first]] = result.accel[first]
-    w.update(start_v=start_v, cruise_v=cruise_v, end_v=end_v, accel=accel)
-    op.plan = (moves, result)
-    op._elapsed = None
+        out["start_v"][moves.waypoint[first]] = result.start_v[first]
+        out["end_v"][moves.waypoint[last]] = result.end_v[last]
+        np.maximum.at(out["cruise_v"], moves.waypoint, result.cruise_v)
+        out["accel"][moves.waypoint[first]] = result.accel[first]
+    return out

@@ -269,7 +269,7 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
     >>> round(float(result.duration_t.sum()), 3)
     2.05
     """
-    moves = firmware_moves(op, None, lambda travel, angle, radius: arc_segments(travel, angle, radius,
+    moves = firmware_moves(op, None, lambda travel, angle, radius, speed_v: arc_segments(travel, angle, radius,
                                                                                  config.arc_tolerance))
     n = len(moves)
     if n == 0:

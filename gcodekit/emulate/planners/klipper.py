@@ -323,11 +323,12 @@ def _move_block(moves, rows, limits, config, flush, lo, hi, m, junction) -> None
 def _cruise(start_v2, mcr_start_v2, m, flush):
     """LookAheadQueue.flush: each move's cruise speed, and the next move's start."""
     n = start_v2.size
-    segment = np.cumsum(flush)
+    segment = np.cumsum(flush, dtype=np.int32)
     last_of_segment = np.r_[segment[1:] != segment[:-1], True]
-    next_start_v2 = np.where(last_of_segment, 0.0, np.r_[start_v2[1:], 0.0])
-    next_mcr_start_v2 = np.where(last_of_segment, 0.0, np.r_[mcr_start_v2[1:], 0.0])
-    reachable_start_v2 = next_start_v2 + m["delta_v2"]
+    next_start_v2 = np.r_[start_v2[1:], 0.0]
+    next_start_v2[last_of_segment] = 0.0
+    next_mcr_start_v2 = np.r_[mcr_start_v2[1:], 0.0]
+    next_mcr_start_v2[last_of_segment] = 0.0
     reach_mcr_start_v2 = next_mcr_start_v2 + m["mcr_delta_v2"]
     # Klipper compares values its sequential loop made equal on purpose (a
     # move whose start is limited by braking for the next); the scans round
@@ -337,12 +338,23 @@ def _cruise(start_v2, mcr_start_v2, m, flush):
     # pending_cv2_assign > 1: the move after this one (same flush) could not accelerate
     pending = ~last_of_segment & ~np.r_[can_accel[1:], True]
     update = can_accel & ((mcr_start_v2 + m["mcr_delta_v2"] > next_mcr_start_v2 + tie) | pending)
+    del tie, pending, next_mcr_start_v2
     nearest = np.minimum(next_marked(update), n - 1)
     has_peak = update[nearest] & (segment[nearest] == segment)
-    peak_cruise_v2 = np.where(has_peak, (mcr_start_v2 + reach_mcr_start_v2)[nearest] * 0.5, 0.0)
-    cruise_v2 = _minimum((start_v2 + reachable_start_v2) * 0.5, m["max_cruise_v2"], peak_cruise_v2)
+    peak_cruise_v2 = mcr_start_v2 + reach_mcr_start_v2  # twice the peak; halved below
+    del reach_mcr_start_v2
+    peak_cruise_v2 = peak_cruise_v2[nearest]
+    peak_cruise_v2 *= 0.5
+    peak_cruise_v2[~has_peak] = 0.0
+    del nearest, has_peak, update
+    cruise_v2 = next_start_v2 + m["delta_v2"]  # reachable_start_v2
+    cruise_v2 += start_v2
+    cruise_v2 *= 0.5
+    np.minimum(cruise_v2, m["max_cruise_v2"], out=cruise_v2)
+    np.minimum(cruise_v2, peak_cruise_v2, out=cruise_v2)
+    del peak_cruise_v2
     # forward: a move that cannot accelerate keeps min(previous cruise, its start)
-    chain = np.cumsum(can_accel | flush)
+    chain = np.cumsum(can_accel | flush, dtype=np.int32)
     seed = np.where(can_accel, cruise_v2, np.where(flush, 0.0, start_v2))
     return segmented_cummin(seed, chain), next_start_v2
 

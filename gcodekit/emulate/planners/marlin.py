@@ -259,7 +259,7 @@ def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResul
     (10.0, 2.041)
     """
     factor = _speed_factor(op)
-    moves = firmware_moves(op, factor, lambda travel, angle, radius: arc_segments(
+    moves = firmware_moves(op, factor, lambda travel, angle, radius, speed_v: arc_segments(
         travel, angle, radius, config.max_arc_segment_mm, config.min_circle_segments))
     n = len(moves)
     if n == 0:
@@ -367,7 +367,7 @@ def _junction_deviation(dist_mm, esteps, inverse_millimeters, millimeters, nomin
         small = (millimeters < 1.0) & (junction_cos_theta < COS_OCTAGON)
         junction_theta = np.arccos(np.clip(-junction_cos_theta, -1.0, 1.0))
         arc_sqr = np.divide(millimeters * junction_acceleration, junction_theta,
-                            out=np.full_like(millimeters, np.inf), where=small)
+                            out=np.full_like(millimeters, np.inf), where=small & (junction_theta > 0))
         vmax_junction_sqr = np.minimum(vmax_junction_sqr, arc_sqr)
     vmax_junction_sqr = np.where(junction_cos_theta > COS_REVERSAL, config.minimum_planner_speed**2, vmax_junction_sqr)
     return np.minimum(vmax_junction_sqr, np.minimum(nominal_speed, nominal_speed[prev]) ** 2)
