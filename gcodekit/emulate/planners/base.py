@@ -138,7 +138,7 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
     changed = np.zeros(n, bool)
     for col in columns:  # compare with the previous waypoint column by column
-        changed[0] |= col[0] != 0
+        changed[:1] |= col[:1] != 0
         changed[1:] |= col[1:] != col[:-1]
     idx = np.flatnonzero((w["motion"] > 0) & ~homing & changed)
     end = np.empty((idx.size, 4))
