@@ -7,7 +7,7 @@ the chunks into one :class:`~gcodekit.emulate.operation.Operation`.
 Examples
 --------
 >>> import gcodekit
->>> df = gcodekit.gcode_file_to_dataframe("G1 X10 Y0 F600\\nG2 X0 Y0 I-5 J0\\n", machine="linuxcnc")
+>>> df = gcodekit.gcode_file_to_dataframe("G1 X10 Y0 F600\\nG2 X0 Y0 I-5 J0\\n", machine="linuxcnc", plan=False)
 >>> df[["motion", "x", "distance"]].round(3).values.tolist()
 [['feed', 10.0, 10.0], ['arc_cw', 0.0, 15.708]]
 """
@@ -158,7 +158,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
 
     Examples
     --------
-    >>> op = gcode_to_operation("G21\\nG0 X10\\nG1 Y5 F300\\n", machine="linuxcnc")
+    >>> op = gcode_to_operation("G21\\nG0 X10\\nG1 Y5 F300\\n", machine="linuxcnc", plan=False)
     >>> op.process_data[2].location[:2], op.process_data[2].duration
     ((10.0, 5.0), 1.0)
     """

@@ -9,7 +9,7 @@ same step and are built from the columns when indexed.
 Examples
 --------
 >>> import gcodekit
->>> op = gcodekit.gcode_to_operation("G21 G90\\nG1 X10 F600\\nG1 Y10\\n", machine="linuxcnc")
+>>> op = gcodekit.gcode_to_operation("G21 G90\\nG1 X10 F600\\nG1 Y10\\n", machine="linuxcnc", plan=False)
 >>> op.get_bounds()["max"], round(op.get_statistics()["time_s"], 3)
 ([10.0, 10.0, 0.0], 2.0)
 """
