@@ -19,10 +19,9 @@ import os
 import re
 import sys
 from pathlib import Path
-from typing import Iterator
+from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
-import pandas as pd
 
 from .emulate.machine import Machine
 from .emulate.operation import OPERATION_CLASSES, Operation
@@ -31,6 +30,9 @@ from .errors import ConfigError, Diagnostics, check_choice
 from .parse import CommandTable, GcodeParser
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
 from .syntax import Flavor, detect_flavor, load_flavor
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate_operation", "resolve"]
 
@@ -200,7 +202,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
 
 
 def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineConfig | None = None,
-                            **kwargs) -> pd.DataFrame:
+                            **kwargs) -> "pd.DataFrame":
     """The waypoint table of a program as a DataFrame (see ``Operation.to_dataframe``)."""
     return gcode_to_operation(source, machine, **kwargs).to_dataframe()
 

@@ -1,9 +1,9 @@
-"""``import gcodekit`` loads NumPy and pandas only; heavy libraries load on first use."""
+"""``import gcodekit`` loads NumPy only; pandas and heavier libraries load on first use."""
 
 import subprocess
 import sys
 
-HEAVY = ["pyvista", "vtk", "matplotlib", "ipywidgets", "trame", "jinja2", "tqdm", "hypothesis", "scipy"]
+HEAVY = ["pandas", "pyvista", "vtk", "matplotlib", "ipywidgets", "trame", "jinja2", "tqdm", "hypothesis", "scipy"]
 
 
 def test_import_is_light():

@@ -22,7 +22,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from ..errors import Diagnostics
 from ..parse.commands import Command, Kind
@@ -32,6 +31,8 @@ from .machine import FLOAT_COLUMNS, SMALL_COLUMNS
 from .state import MM_PER_INCH
 
 if TYPE_CHECKING:
+    import pandas as pd
+
     from ..syntax import Flavor
     from .presets import MachineConfig
 
@@ -249,23 +250,27 @@ class Operation:
 
     # -- tables -------------------------------------------------------------------
 
-    def time_by(self, key: str = "layer") -> pd.DataFrame:
+    def time_by(self, key: str = "layer") -> "pd.DataFrame":
         """Time, distance and filament per ``"layer"``, ``"feature"`` or ``"tool"``."""
+        import pandas as pd
+
         if not self._require_emulation("time_by()"):
             return pd.DataFrame()
         from ..analysis import time_by
 
         return time_by(self, key)
 
-    def velocity_profile(self) -> pd.DataFrame:
+    def velocity_profile(self) -> "pd.DataFrame":
         """Planned and commanded speed over time (see :func:`gcodekit.analysis.velocity_profile`)."""
+        import pandas as pd
+
         if not self._require_emulation("velocity_profile()"):
             return pd.DataFrame()
         from ..analysis import velocity_profile
 
         return velocity_profile(self)
 
-    def to_dataframe(self) -> pd.DataFrame:
+    def to_dataframe(self) -> "pd.DataFrame":
         """One row per waypoint: command columns then process columns.
 
         Columns: ``line``, ``command`` (row in ``commands``), ``code``,
@@ -273,6 +278,8 @@ class Operation:
         ``elapsed_time``.  Before emulation, one row per command with only
         the command columns and the parameters.
         """
+        import pandas as pd
+
         t = self.table
         if self.waypoints is None:
             frame = pd.DataFrame({"line": t.line, "code": self._codes(), "kind": self._kinds()})
@@ -313,11 +320,13 @@ class Operation:
             codes[row] = name
         return codes
 
-    def _kinds(self) -> pd.Categorical:
+    def _kinds(self) -> "pd.Categorical":
+        import pandas as pd
+
         names = [k.name.lower() for k in Kind]
         return pd.Categorical.from_codes(self.table.kind.astype(np.int64), categories=names)
 
-    def motions(self) -> pd.DataFrame:
+    def motions(self) -> "pd.DataFrame":
         """One row per motion, in the program's units in force at each move.
 
         Columns ``line, motion, x, y, z, a, b, c, feed, cx, cy, cz, plane,
@@ -327,6 +336,8 @@ class Operation:
         ``XY``/``XZ``/``YZ``, the move's duration and the time at its end (s).
         A planned operation adds ``start_v, cruise_v, end_v`` (units/s).
         """
+        import pandas as pd
+
         if not self._require_emulation("motions()"):
             return pd.DataFrame()
         w = self.waypoints
