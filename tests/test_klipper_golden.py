@@ -83,3 +83,9 @@ def test_printer_cfg_errors_name_the_file(tmp_path):
     bad.write_text("[printer]\nmax_velocity: fast\nmax_accel: 3000\n")
     with pytest.raises(gcodekit.ConfigError, match=r"printer\.cfg.*max_velocity"):
         gcodekit.gcode_to_operation(CASES / "a_only.gcode", "klipper", machine_config=bad)
+
+
+def test_radius_arcs_are_rejected_like_klipper():
+    op = gcodekit.gcode_to_operation("G1 X10 F6000\nG2 X20 Y0 R5\nG1 X30\n", "klipper", machine_config=CONFIG)
+    assert op.motions()["x"].tolist() == [10.0, 30.0]
+    assert [d.line for d in op.diagnostics if "R-form" in d.message] == [2]

@@ -139,6 +139,8 @@ class Machine:
         moving = np.isin(kind, _MOVING)
         if self.config.empty_moves:
             moving |= np.isin(t.name[rows], self._straight_ids)
+        if not self.config.radius_arcs and "R" in t.params:
+            self._reject_radius_arcs(t, rows, moving)
         motion = np.where(moving, t.motion[rows], 0).astype(np.uint8)
         offset = s.offset
         scale = s.scale()
@@ -194,6 +196,15 @@ class Machine:
         elif s.feed_mode == "per_rev":
             s.feed = float(_forward_fill(feed_words, s.feed)[-1])
         s.speed = float(speed[-1])
+
+    def _reject_radius_arcs(self, t: CommandTable, rows: slice, moving: np.ndarray) -> None:
+        """Firmware without R-form arcs (Klipper) refuses the command: nothing moves."""
+        arc = (t.motion[rows] == MOTION_CW) | (t.motion[rows] == MOTION_CCW)
+        refused = moving & arc & ~np.isnan(_dense(t.params["R"], rows))
+        for i in np.flatnonzero(refused)[:20]:
+            self.diagnostics.report(int(t.line[rows][i]), 1, "this firmware rejects R-form arcs (give I/J); the arc is skipped",
+                                    kind="machine")
+        moving &= ~refused
 
     def _extrusion(self, t: CommandTable, rows: slice, moving: np.ndarray) -> np.ndarray:
         s = self.state

@@ -59,6 +59,8 @@ class MachineConfig:
         choose which axes home to the stored position (printer firmware).
     tool_change_on : {"M6", "T"}
         The word that puts the selected tool in the spindle/extruder.
+    radius_arcs : bool
+        G2/G3 with R are accepted (Klipper rejects them: the arc is skipped).
     empty_moves : bool
         A G0/G1 with no axis words still makes a zero-length move (LinuxCNC's
         interpreter does; firmware only updates the mode and feed).
@@ -97,6 +99,7 @@ class MachineConfig:
     dwell_p_unit: str = "s"
     home_mode: str = "stored"
     tool_change_on: str = "M6"
+    radius_arcs: bool = True
     empty_moves: bool = False
     distance_mode_sets_extrusion: bool = False
     block_delete: bool = False
