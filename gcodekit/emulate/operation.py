@@ -300,6 +300,7 @@ class Operation:
 
             data.update(waypoint_speeds(self))
         data["elapsed_time"] = self.elapsed_time()
+        data["start_time"] = data["elapsed_time"] - np.nan_to_num(np.asarray(w["time"], float))
         return pd.DataFrame(data, copy=False)
 
     def _codes(self) -> np.ndarray:
