@@ -90,10 +90,21 @@ def first_difference(ours: pd.DataFrame, ref: pd.DataFrame, exact: list[str],
             f"{a.at[i, 'line']}, in {cols}:\n{table.to_string()}")
 
 
+def tool_table(name: str) -> Path:
+    """The tool table rs274 ran the case with (TOOLTABLE_OVERRIDES.tsv, else tool.tbl)."""
+    tables = CASES.parent / "tooltables"
+    for line in (tables / "overrides.tsv").read_text().splitlines():
+        program, _, table = line.partition("\t")
+        if not line.startswith("#") and Path(program).name == name:
+            return tables / Path(table).name
+    return tables / "tool.tbl"
+
+
 @cache
 def motions(name: str) -> tuple[pd.DataFrame, pd.DataFrame, list]:
     """(our motions, reference motions, diagnostics) of one case."""
-    op = gcodekit.gcode_to_operation(CASES / name, machine="linuxcnc")
+    op = gcodekit.gcode_to_operation(CASES / name, machine="linuxcnc", plan=False, tool_table=tool_table(name),
+                                     tool_table_units="inch")  # rs274 standalone reads tables in inches
     return op.motions(), reference_motions(CASES / (name + ".canon.csv")), op.diagnostics.items
 
 

@@ -263,3 +263,27 @@ def test_ger_relaxed_statements():
     assert op.commands[0].comment == "a comment over two lines"
     # the program starts in rapid mode: axis words alone move at once
     assert gcodekit.gcode_to_operation("X1 Y1\n", "ger").motions()["motion"].tolist() == ["rapid"]
+
+
+def test_tool_length_offsets_g10_and_g52(tmp_path):
+    table = tmp_path / "tools.tbl"
+    table.write_text("T1 P1 Z0.5 D0.25 ;end mill\nT2 P2 Z1.0\n")
+    text = "\n".join([
+        "G20 T1 M6",
+        "G43 H1",            # tool 1: +0.5 in; the program position stays 0
+        "G0 X1",             # ... so the machine reaches Z 0.5 in on this move
+        "G43.2 H2",          # add tool 2: 1.5 in in all
+        "G0 Z0",
+        "G49 G0 Z0",
+        "G10 L2 P2 X2",      # G55 is at X 2 in
+        "G55 G0 X0",
+        "G10 L20 P1 X1",     # the current point becomes X 1 in G54
+        "G54 G0 X1",
+        "G52 X0.5",          # LinuxCNC: a local offset kept in the G92 slot
+        "G0 X1",
+        "G43.1 Z-0.25 G0 Z0",
+    ]) + "\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, tool_table=table, tool_table_units="mm")
+    m = op.motions()
+    np.testing.assert_allclose(m[["x", "z"]].to_numpy(), [
+        [1, 0.5 / 25.4], [1, 1.5 / 25.4], [1, 0], [2, 0], [2, 0], [2.5, 0], [2.5, -0.25]], atol=1e-12)

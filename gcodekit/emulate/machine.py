@@ -23,6 +23,7 @@ from . import arcs
 from .modal import SPECIAL_NAMES, ModalHandler, Waypoint
 from .presets import MachineConfig
 from .state import AXES, LINEAR, MachineState
+from .tooltable import ToolTable
 
 #: Float columns of the waypoint table, with their meaning and unit.
 FLOAT_COLUMNS = {
@@ -44,7 +45,6 @@ SMALL_COLUMNS = {
 _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTRUDE, Kind.MOVE_MILL,
                            Kind.ARC_MILL, Kind.EXTRUDE}), np.uint8)
 _MILL = np.array([Kind.MILL, Kind.MOVE_MILL, Kind.ARC_MILL], np.uint8)
-_NO_FEED_WORD = np.array([Kind.M, Kind.COMMENT], np.uint8)
 
 
 class Machine:
@@ -59,10 +59,14 @@ class Machine:
     """
 
     def __init__(self, config: MachineConfig, diagnostics: Diagnostics | None = None, *,
-                 rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = ""):
+                 rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = "",
+                 feed_in_any_block: bool = False):
         self.config = config
         self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
         self.rapid_is_feed = config.rapid_is_feed if config.rapid_is_feed is not None else rapid_is_feed
+        # RS274NGC: an F word sets the feed whatever else the block does; printer
+        # firmware reads F only on moves (an M-code's F means something else).
+        self.feed_in_any_block = feed_in_any_block
         self.state = MachineState()
         self.state.units = 25.4 if initial_units == "inch" else 1.0
         self.state.e_relative = initial_extrusion == "relative"
@@ -70,6 +74,7 @@ class Machine:
             self.state.feed = config.initial_feed
         for code, vector in config.work_offsets.items():
             self.state.work_offsets[_WORK_INDEX[code], : len(vector)] = vector
+        self.tools = ToolTable.read(config.tool_table, units=config.tool_table_units) if config.tool_table else ToolTable()
         self.modal = ModalHandler(self)
         self._straight_ids = np.array([NAME_ID["rapid"], NAME_ID["linear"]], np.uint8)
         self._warned: set[str] = set()
@@ -157,10 +162,17 @@ class Machine:
                 position[:, ax] = program[ax] + np.cumsum(np.nan_to_num(values)) + offset[ax]
             else:
                 position[:, ax] = _forward_fill(values, program[ax]) + offset[ax]
+        if s.program_shift.any():  # until the first move the machine stays where it is
+            waiting = np.cumsum(moving) == 0
+            position[waiting] = s.position
+            if moving.any():
+                s.program_shift[:] = 0.0
         start_pos = np.vstack([s.position[None, :], position[:-1]])
 
         feed_words = _dense(t.params["F"], rows) * s.units if "F" in t.params else np.full(n, np.nan)
-        feed_words[np.isin(kind, _NO_FEED_WORD)] = np.nan
+        feed_words[kind == Kind.COMMENT] = np.nan
+        if not self.feed_in_any_block:
+            feed_words[kind == Kind.M] = np.nan
         if s.feed_mode == "inverse_time":
             feed = feed_words  # 1/min, for this block only
         else:

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..parse.table import MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, NAMES, CommandTable
 from .state import AXES, MachineState
+from .tooltable import Tool
 
 if TYPE_CHECKING:
     from .machine import Machine
@@ -28,7 +29,9 @@ SPECIAL_NAMES = frozenset(
     restore_position_offset home home_secondary store_home store_home_secondary
     extrude_absolute extrude_relative set_flow tool_change spindle_cw spindle_ccw spindle_off
     coolant_mist coolant_flood coolant_off program_end machine_coordinates
-    firmware_retract firmware_unretract set_kinematic_position""".split()
+    firmware_retract firmware_unretract set_kinematic_position
+    tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
+    coordinate_data local_offset""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)}
 
 _SIMPLE = {
@@ -71,7 +74,7 @@ class ModalHandler:
         if self.machine.config.block_delete and row in set(t.deleted.tolist()):
             self._write(out, row, before, MOTION_NONE)
             return []
-        if "F" in params and chr(int(t.letter[row])) != "M":
+        if "F" in params and (chr(int(t.letter[row])) != "M" or self.machine.feed_in_any_block):
             s.feed = params["F"] * s.units
         if name in _SIMPLE:
             attr, value = _SIMPLE[name]
@@ -109,6 +112,22 @@ class ModalHandler:
             s.coolant = {"coolant_mist": s.coolant | 1, "coolant_flood": s.coolant | 2, "coolant_off": 0}[name]
         elif name == "program_end":
             self._end_program()
+        elif name in ("tool_length_offset", "tool_length_offset_add"):
+            number = params.get("H", s.tool)
+            offset = self.machine.tools.offset(int(number))
+            s.change_tool_offset(offset if name == "tool_length_offset" else s.tool_offset + offset)
+        elif name == "tool_length_offset_dynamic":
+            scale = s.scale()
+            s.change_tool_offset([params.get(letter, 0.0) * scale[ax] for ax, letter in enumerate(AXES)])
+        elif name == "cancel_tool_length":
+            s.change_tool_offset(np.zeros(6))
+        elif name == "coordinate_data":
+            self._coordinate_data(params, line)
+        elif name == "local_offset":
+            scale = s.scale()
+            for ax, letter in enumerate(AXES):
+                if letter in params:  # LinuxCNC keeps G52 in the G92 offset
+                    s.g92[ax] = params[letter] * scale[ax]
         elif name == "set_kinematic_position":
             self._set_kinematic_position(t.command(row).text)
         elif name in ("firmware_retract", "firmware_unretract"):
@@ -116,6 +135,8 @@ class ModalHandler:
             if filament is not None:
                 self._write(out, row, before, MOTION_LINEAR, *filament)
                 return extra
+        if motion != MOTION_NONE:
+            s.program_shift[:] = 0.0  # the machine has reached the offsets in force
         for w in extra:
             self._fill_passing(w, before)
             before = np.array([w.values[k] for k in AXES.lower()])
@@ -135,6 +156,39 @@ class ModalHandler:
             s.g92[ax] = s.position[ax] - s.work_offsets[s.work_offset][ax] - params[AXES[ax]] * scale[ax]
         if "E" in params:
             s.e_program = params["E"] * s.units
+
+    def _coordinate_data(self, params: dict, line: int) -> None:
+        """G10: L2/L20 set a work offset, L1/L10/L11 a tool's offsets (LinuxCNC 2.9)."""
+        s = self.state
+        scale = s.scale()
+        mode = int(params.get("L", -1))
+        given = [ax for ax, letter in enumerate(AXES) if letter in params]
+        if mode in (2, 20):
+            index = int(params.get("P", 0)) or s.work_offset
+            if not 1 <= index <= 9:
+                self.machine.diagnostics.report(line, 1, f"G10 L{mode} P must be 0 to 9", kind="machine")
+                return
+            for ax in given:
+                value = params[AXES[ax]] * scale[ax]
+                if mode == 2:
+                    s.work_offsets[index, ax] = value
+                else:  # L20: the current point gets coordinate `value` in system P
+                    s.work_offsets[index, ax] = s.position[ax] - s.g92[ax] - s.tool_offset[ax] - value
+        elif mode in (1, 10, 11):
+            number = int(params.get("P", 0))
+            tool = self.machine.tools.setdefault(number, Tool(number))
+            for ax in given:
+                value = params[AXES[ax]] * scale[ax]
+                if mode == 1:
+                    tool.offset[ax] = value
+                else:  # the current point would have coordinate `value` with this tool's offset
+                    system = s.work_offsets[9 if mode == 11 else s.work_offset]
+                    g92 = 0.0 if mode == 11 else s.g92[ax]
+                    tool.offset[ax] = s.position[ax] - system[ax] - g92 - value
+            if "R" in params:
+                tool.diameter = 2 * params["R"] * s.units
+        else:
+            self.machine.diagnostics.report(line, 1, "G10 needs L1, L2, L10, L11 or L20", kind="machine")
 
     def _home(self, params: dict, secondary: bool) -> list[Waypoint]:
         s = self.state

@@ -29,6 +29,7 @@ _CHOICES = {
     "dwell_p_unit": ("s", "ms"),
     "home_mode": ("stored", "select"),
     "tool_change_on": ("M6", "T"),
+    "tool_table_units": ("mm", "inch"),
 }
 
 
@@ -79,6 +80,11 @@ class MachineConfig:
         Firmware retraction (G10/G11) filament length, mm; 0 disables it.
     retract_speed, unretract_speed : float
         Firmware retraction speeds, mm/s.
+    tool_table : str
+        Path of a LinuxCNC tool table (``.tbl``) for G43 and G10 L1; ``""``
+        for none (every tool then has zero offsets).
+    tool_table_units : {"mm", "inch"}
+        Units of the tool table's lengths (rs274 standalone reads inches).
     dwell_s_seconds : bool
         ``G4 S`` is a dwell in seconds (Marlin, RepRapFirmware); Klipper
         ignores S.
@@ -110,6 +116,8 @@ class MachineConfig:
     retract_speed: float = 20.0
     unretract_extra_length: float = 0.0
     unretract_speed: float = 10.0
+    tool_table: str = ""
+    tool_table_units: str = "mm"
     dwell_s_seconds: bool = True
     planner: str = ""
     planner_settings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))

@@ -39,6 +39,11 @@ class MachineState:
     work_offset: int = 1  # 1..9 for G54..G59.3
     work_offsets: np.ndarray = field(default_factory=lambda: np.zeros((10, N_AXES)))
     g92: np.ndarray = field(default_factory=_zeros)
+    tool_offset: np.ndarray = field(default_factory=_zeros)  # G43 tool length offset
+    # LinuxCNC keeps the program position when the tool offset changes: the
+    # machine reaches the new offset on the next move.  Until then the program
+    # position differs from position - offset by this much.
+    program_shift: np.ndarray = field(default_factory=_zeros)
     g92_saved: np.ndarray | None = None
     home: np.ndarray = field(default_factory=_zeros)  # G28 stored position
     home_secondary: np.ndarray = field(default_factory=_zeros)  # G30 stored position
@@ -53,10 +58,16 @@ class MachineState:
     @property
     def offset(self) -> np.ndarray:
         """Total offset from program to machine coordinates."""
-        return self.work_offsets[self.work_offset] + self.g92
+        return self.work_offsets[self.work_offset] + self.g92 + self.tool_offset
 
     def program_position(self) -> np.ndarray:
-        return self.position - self.offset
+        return self.position - self.offset + self.program_shift
+
+    def change_tool_offset(self, offset: np.ndarray) -> None:
+        """New tool length offset; the program position stays (no motion)."""
+        before = self.program_position()
+        self.tool_offset = np.asarray(offset, float).copy()
+        self.program_shift = before - (self.position - self.offset)
 
     def scale(self) -> np.ndarray:
         """Program units to mm per axis (rotary axes stay in degrees)."""

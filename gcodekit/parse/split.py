@@ -26,7 +26,7 @@ AXIS_LETTERS = frozenset("XYZABCUVW")
 #: Commands that take axis words in the same block.
 AXIS_CONSUMERS = frozenset(
     {"rapid", "linear", "arc_cw", "arc_ccw", "set_position", "home", "home_secondary",
-     "machine_coordinates", "probe"}
+     "machine_coordinates", "probe", "coordinate_data", "local_offset", "tool_length_offset_dynamic"}
 )
 MOTIONS = frozenset({"rapid", "linear", "arc_cw", "arc_ccw", "probe", "cancel_cycle"})
 
@@ -39,14 +39,15 @@ _RANK = {
     "dwell": 14, "plane_xy": 15, "plane_zx": 15, "plane_yz": 15,
     "units_inch": 16, "units_mm": 16,
     "cutter_comp_off": 17, "cutter_comp_left": 17, "cutter_comp_right": 17,
-    "tool_length_offset": 18, "tool_length_offset_dynamic": 18, "cancel_tool_length": 18,
+    "tool_length_offset": 18, "tool_length_offset_dynamic": 18, "tool_length_offset_add": 18,
+    "cancel_tool_length": 18,
     **{f"work_offset_{k}": 19 for k in range(1, 10)},
     "exact_stop": 20, "path_blending": 20,
     "distance_absolute": 21, "distance_incremental": 21,
     "arc_distance_absolute": 21, "arc_distance_incremental": 21,
     "set_position": 23, "clear_position_offset": 23, "suspend_position_offset": 23,
     "restore_position_offset": 23, "home": 23, "home_secondary": 23,
-    "store_home": 23, "store_home_secondary": 23,
+    "store_home": 23, "store_home_secondary": 23, "coordinate_data": 23, "local_offset": 23,
     "machine_coordinates": 24, "rapid": 24, "linear": 24, "arc_cw": 24, "arc_ccw": 24,
     "probe": 24, "cancel_cycle": 24,
     "program_stop": 25, "optional_stop": 25, "program_end": 25,
@@ -159,7 +160,8 @@ def _split_modal(words, flavor):
     if consumer is None and (has_axes or "E" in rest):
         consumer = Part("")  # a move in the modal motion mode
         ordered.insert(_insert_at(ordered, flavor, 24), consumer)
-    special = {"P": ("dwell",), "H": ("tool_length_offset", "tool_length_offset_dynamic"),
+    special = {"P": ("dwell", "coordinate_data"), "L": ("coordinate_data",),
+               "H": ("tool_length_offset", "tool_length_offset_add"),
                "D": ("cutter_comp_left", "cutter_comp_right"), "T": ("tool_change",),
                "S": ("spindle_cw", "spindle_ccw")}
     for letter in list(rest):

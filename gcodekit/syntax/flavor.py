@@ -36,7 +36,8 @@ COMMANDS = frozenset(
     tool_change spindle_cw spindle_ccw spindle_off
     coolant_mist coolant_flood coolant_off
     program_stop optional_stop program_end
-    tool_length_offset tool_length_offset_dynamic cancel_tool_length
+    tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
+    coordinate_data local_offset
     cutter_comp_off cutter_comp_left cutter_comp_right
     cancel_cycle exact_stop path_blending
     set_hotend_temp wait_hotend_temp set_bed_temp wait_bed_temp set_chamber_temp

@@ -10,7 +10,7 @@ of them matched to a source line (``line_match == ok``), no rotary-axis work
 or G92 offset is active (the CSV only carries X/Y/Z offsets), and its text
 (comments stripped) uses only the foundation features: no O-words or
 subprograms, cutter compensation, canned or lathe cycles, threading, probing,
-splines, lathe modes, G10, tool length offsets, G52, polar words, I/O M-codes,
+splines, lathe modes, polar words, I/O M-codes,
 user or unknown codes, or system parameters.
 
 Usage::
@@ -36,6 +36,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 CASES = HERE / "cases"
+TABLES = Path(__file__).parent / "tooltables"
 MANIFEST = HERE / "manifest.tsv"
 SHARED = HERE.parents[3] / "shared"
 TOOLS = SHARED / "tools" / "linuxcnc"
@@ -73,13 +74,10 @@ EXCLUDED_G = {
     **dict.fromkeys(("38.2", "38.3", "38.4", "38.5"), "probing"),
     **dict.fromkeys(("5", "5.1", "5.2", "5.3"), "spline"),
     **dict.fromkeys(("7", "8"), "lathe diameter/radius mode"),
-    "10": "G10 table write",
-    **dict.fromkeys(("43", "43.1", "43.2"), "tool length offset"),
-    "52": "local offset",
     **dict.fromkeys(("70", "71", "71.1", "71.2", "72", "72.1", "72.2"), "lathe cycle"),
 }
 ALLOWED_G = frozenset("""
-0 1 2 3 4 17 17.1 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 49 53 54 55 56 57 58
+0 1 2 3 4 10 17 17.1 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 43 43.1 43.2 49 52 53 54 55 56 57 58
 59 59.1 59.2 59.3 61 61.1 64 80 90 90.1 91 91.1 92 92.1 92.2 92.3 93 94 95 96 97
 98 99
 """.split())
@@ -235,6 +233,11 @@ def main(argv: list[str] | None = None) -> int:
             expected = fresh if args.rerun else corpus / (program + ".canon.csv")
             shutil.copyfile(corpus / program, CASES / name)
             shutil.copyfile(expected, CASES / (name + ".canon.csv"))
+    # the tool tables rs274 ran with (inches), and which case used which
+    TABLES.mkdir(exist_ok=True)
+    for table in (corpus / "tooltables").glob("*.tbl"):
+        shutil.copyfile(table, TABLES / table.name)
+    shutil.copyfile(corpus / "TOOLTABLE_OVERRIDES.tsv", TABLES / "overrides.tsv")
     with MANIFEST.open("w", newline="") as f:
         w = csv.writer(f, delimiter="\t", lineterminator="\n")
         w.writerow(["program", "motions", "golden", "reason"])
