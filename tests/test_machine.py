@@ -287,3 +287,30 @@ def test_tool_length_offsets_g10_and_g52(tmp_path):
     m = op.motions()
     np.testing.assert_allclose(m[["x", "z"]].to_numpy(), [
         [1, 0.5 / 25.4], [1, 1.5 / 25.4], [1, 0], [2, 0], [2, 0], [2.5, 0], [2.5, -0.25]], atol=1e-12)
+
+
+def test_canned_cycles_follow_linuxcnc():
+    text = "G21 G90 G17 G0 X0 Y0 Z10\nG98 G81 X10 Y5 Z-3 R2 F100\nX20\nG99 G83 X30 Z-5 R1 Q2\nG80\nG0 Z10\n"
+    m = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False).motions()
+    expected = [  # (line, motion, x, z): worked out from the LinuxCNC manual's cycle descriptions
+        (1, "rapid", 0, 10),
+        (2, "rapid", 10, 10), (2, "rapid", 10, 2), (2, "feed", 10, -3), (2, "rapid", 10, 10),  # G98: back to 10
+        (3, "rapid", 20, 10), (3, "rapid", 20, 2), (3, "feed", 20, -3), (3, "rapid", 20, 10),  # modal repeat
+        (4, "rapid", 30, 10), (4, "rapid", 30, 1),
+        (4, "feed", 30, -1), (4, "rapid", 30, 1), (4, "rapid", 30, -1 + 0.254),   # peck 2 mm, out, back in
+        (4, "feed", 30, -3), (4, "rapid", 30, 1), (4, "rapid", 30, -3 + 0.254),
+        (4, "feed", 30, -5), (4, "rapid", 30, 1),                                   # G99: retract to R
+        (6, "rapid", 30, 10),
+    ]
+    got = list(zip(m["line"], m["motion"], m["x"], m["z"]))
+    assert [g[:2] for g in got] == [e[:2] for e in expected]
+    np.testing.assert_allclose([g[2:] for g in got], [e[2:] for e in expected], atol=1e-12)
+
+
+def test_incremental_canned_cycle_repeats():
+    # G91: R from the start Z, Z from R; X increments repeated L times
+    m = gcodekit.gcode_to_operation("G21 G0 X0 Y0 Z5\nG91 G81 X10 R-3 Z-4 L3 F60\n", "linuxcnc", plan=False).motions()
+    holes = m[m["motion"] == "feed"]
+    assert holes["x"].tolist() == [10.0, 20.0, 30.0]
+    assert holes["z"].tolist() == [-2.0, -2.0, -2.0]
+    assert m["z"].iloc[-1] == 5.0  # G98 (default): back to the start height

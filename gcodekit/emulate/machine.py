@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import Diagnostics
 from ..parse.commands import Kind
-from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, MOTION_RAPID, NAME_ID, CommandTable
+from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, NAME_ID, CommandTable
 from . import arcs
 from .modal import SPECIAL_NAMES, ModalHandler, Waypoint
 from .presets import MachineConfig
@@ -93,6 +93,7 @@ class Machine:
         out.update({k: np.empty(n, dtype) for k, (dtype, _) in SMALL_COLUMNS.items()})
         special = np.isin(table.name, self.modal.special_ids) | (table.letter == ord("T"))
         special |= table.kind == Kind.MACHINE_COORDINATES
+        special |= (table.motion == MOTION_CYCLE) & np.isin(table.kind, _MOVING)
         if self.config.block_delete and table.deleted.size:
             special[table.deleted] = True
         extra: list[tuple[int, Waypoint]] = []

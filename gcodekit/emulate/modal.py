@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..parse.table import MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, NAMES, CommandTable
+from ..parse.table import MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, NAMES, CommandTable
+from .cycles import CYCLES, run_cycle
 from .state import AXES, MachineState
 from .tooltable import Tool
 
@@ -31,7 +32,7 @@ SPECIAL_NAMES = frozenset(
     coolant_mist coolant_flood coolant_off program_end machine_coordinates
     firmware_retract firmware_unretract set_kinematic_position
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
-    coordinate_data local_offset""".split()
+    coordinate_data local_offset retract_initial retract_r""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)}
 
 _SIMPLE = {
@@ -58,6 +59,7 @@ class ModalHandler:
     def __init__(self, machine: "Machine"):
         self.machine = machine
         self.special_ids = np.array(sorted(NAME_ID[n] for n in SPECIAL_NAMES), np.uint8)
+        self._last_dwell = 0.0  # dwell at the end of a canned cycle's last move
 
     @property
     def state(self) -> MachineState:
@@ -76,7 +78,11 @@ class ModalHandler:
             return []
         if "F" in params and (chr(int(t.letter[row])) != "M" or self.machine.feed_in_any_block):
             s.feed = params["F"] * s.units
-        if name in _SIMPLE:
+        if int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
+            motion, extra = self._cycle(name, params, line)
+        elif name in ("retract_initial", "retract_r"):
+            s.cycle.retract_to_r = name == "retract_r"
+        elif name in _SIMPLE:
             attr, value = _SIMPLE[name]
             setattr(s, attr, value)
             if attr == "incremental" and self.machine.config.distance_mode_sets_extrusion:
@@ -156,6 +162,25 @@ class ModalHandler:
             s.g92[ax] = s.position[ax] - s.work_offsets[s.work_offset][ax] - params[AXES[ax]] * scale[ax]
         if "E" in params:
             s.e_program = params["E"] * s.units
+
+    def _cycle(self, name: str, params: dict, line: int) -> tuple[int, list[Waypoint]]:
+        """A canned-cycle block: its moves become waypoints (see :mod:`.cycles`)."""
+        s = self.state
+        unit = 0.001 if self.machine.config.dwell_p_unit == "ms" else 1.0
+        try:
+            steps = run_cycle(name if name in CYCLES else "", params, s.cycle, position=s.position,
+                              program=s.program_position(), offset=s.offset, scale=s.scale(), plane=s.plane,
+                              incremental=s.incremental, dwell_unit=unit)
+        except ValueError as exc:
+            self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
+            return MOTION_NONE, []
+        if not steps:
+            return MOTION_NONE, []
+        extra = [Waypoint({**dict(zip(AXES.lower(), st.point)), "motion": st.motion, "dwell": st.dwell})
+                 for st in steps[:-1]]
+        s.position = steps[-1].point.copy()
+        self._last_dwell = steps[-1].dwell
+        return steps[-1].motion, extra
 
     def _coordinate_data(self, params: dict, line: int) -> None:
         """G10: L2/L20 set a work offset, L1/L10/L11 a tool's offsets (LinuxCNC 2.9)."""
@@ -269,11 +294,17 @@ class ModalHandler:
     # -- output -------------------------------------------------------------------
 
     def _fill_passing(self, w: Waypoint, before: np.ndarray) -> None:
-        s = self.state
         point = np.array([w.values[k] for k in AXES.lower()])
         distance = float(np.linalg.norm((point - before)[:3]))
-        w.values.update(distance=distance, time=distance / (self.machine.config.rapid_feed / 60.0),
+        rate = self._rate(int(w.values.get("motion", MOTION_RAPID)))
+        dwell = w.values.pop("dwell", 0.0)
+        w.values.update(distance=distance, time=(distance / (rate / 60.0) if distance and rate > 0 else 0.0) + dwell,
                         de=0.0, cx=np.nan, cy=np.nan, cz=np.nan)
+
+    def _rate(self, motion: int) -> float:
+        """Feed of a move made by a special command, mm/min."""
+        s = self.state
+        return s.feed if (motion == MOTION_LINEAR or self.machine.rapid_is_feed) else self.machine.config.rapid_feed
 
     def _write(self, out: dict, row: int, before: np.ndarray, motion: int, de: float = 0.0,
                feed: float | None = None) -> None:
@@ -281,11 +312,11 @@ class ModalHandler:
         for k, v in zip(AXES.lower(), s.position):
             out[k][row] = v
         distance = float(np.linalg.norm((s.position - before)[:3]))
-        rate = s.feed if (motion == MOTION_LINEAR or self.machine.rapid_is_feed) else self.machine.config.rapid_feed
-        rate = rate if feed is None else feed
+        rate = self._rate(motion) if feed is None else feed
         path = distance or abs(de)
         out["distance"][row] = distance
-        out["time"][row] = path / (rate / 60.0) if path and rate > 0 else 0.0
+        out["time"][row] = (path / (rate / 60.0) if path and rate > 0 else 0.0) + self._last_dwell
+        self._last_dwell = 0.0
         out["de"][row] = de
         out["feed"][row] = rate if feed is not None else s.feed
         out["motion"][row] = motion

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .cycles import CycleState
+
 N_AXES = 6  # X Y Z A B C
 AXES = "XYZABC"
 LINEAR = np.array([True, True, True, False, False, False])
@@ -53,6 +55,7 @@ class MachineState:
     spindle: int = 0  # 1 CW, -1 CCW, 0 stopped
     coolant: int = 0  # bit 1 mist, bit 2 flood
     retracted: bool = False  # firmware retraction (G10) in effect
+    cycle: CycleState = field(default_factory=CycleState)  # canned-cycle words in force
     ended: bool = False  # M2/M30 reached: later blocks are not run
 
     @property

@@ -24,7 +24,7 @@ from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
-from .table import MOTION_NONE, MOTION_OF_NAME, NAME_ID, CommandTable
+from .table import CYCLE_NAMES, MOTION_CYCLE, MOTION_NONE, MOTION_OF_NAME, NAME_ID, CommandTable
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
 _KEEP = 255  # "this row does not set the motion mode"
@@ -53,6 +53,7 @@ class GcodeParser:
         self._modal_motion = self.flavor.block_split != "single"  # firmware needs a code on every move
         self._name_cache: dict[int, int] = {}
         self._unknown_reported: set[str] = set()
+        self._cycle_ids = np.array([NAME_ID[n] for n in CYCLE_NAMES], np.uint8)
 
     # -- public ---------------------------------------------------------------
 
@@ -255,8 +256,8 @@ class GcodeParser:
         sets = np.full(n, _KEEP, np.uint8)
         for mname, mode in MOTION_OF_NAME.items():
             sets[name == NAME_ID[mname]] = mode
-        if "cancel_cycle" in NAME_ID:
-            sets[name == NAME_ID["cancel_cycle"]] = MOTION_NONE
+        sets[name == NAME_ID["cancel_cycle"]] = MOTION_NONE
+        sets[np.isin(name, self._cycle_ids)] = MOTION_CYCLE
         g53 = name == NAME_ID["machine_coordinates"]
         for i in np.flatnonzero(g53 & (letter != 0)):
             part = t.get("parts_by_row", {}).get(int(i))
@@ -276,7 +277,7 @@ class GcodeParser:
         has_axes, has_e, has_s, has_f = has("XYZABCUVW"), has("E"), has("S"), has("F")
         arc = (motion == 3) | (motion == 4)
         has_axes |= arc & has("IJKR")  # "G2 I5" is a full circle from where the tool is
-        is_motion_name = np.isin(name, [NAME_ID[m] for m in MOTION_OF_NAME])
+        is_motion_name = np.isin(name, [NAME_ID[m] for m in MOTION_OF_NAME]) | np.isin(name, self._cycle_ids)
         implicit = (letter == 0) & has_axes if self._modal_motion else np.zeros(n, bool)
         moving = (is_motion_name | implicit) & (has_axes | has_e)
 

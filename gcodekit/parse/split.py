@@ -23,12 +23,14 @@ from ..syntax import Flavor
 from ..syntax.flavor import code_label
 
 AXIS_LETTERS = frozenset("XYZABCUVW")
+CYCLES = frozenset({"cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
+                    "cycle_bore_stop", "cycle_bore_dwell"})
 #: Commands that take axis words in the same block.
 AXIS_CONSUMERS = frozenset(
     {"rapid", "linear", "arc_cw", "arc_ccw", "set_position", "home", "home_secondary",
      "machine_coordinates", "probe", "coordinate_data", "local_offset", "tool_length_offset_dynamic"}
-)
-MOTIONS = frozenset({"rapid", "linear", "arc_cw", "arc_ccw", "probe", "cancel_cycle"})
+) | CYCLES
+MOTIONS = frozenset({"rapid", "linear", "arc_cw", "arc_ccw", "probe", "cancel_cycle"}) | CYCLES
 
 # Rank of each normalized command in LinuxCNC's order of execution
 # (LinuxCNC 2.9 docs, "G-code overview: order of execution").
@@ -42,14 +44,14 @@ _RANK = {
     "tool_length_offset": 18, "tool_length_offset_dynamic": 18, "tool_length_offset_add": 18,
     "cancel_tool_length": 18,
     **{f"work_offset_{k}": 19 for k in range(1, 10)},
-    "exact_stop": 20, "path_blending": 20,
+    "exact_stop": 20, "path_blending": 20, "retract_initial": 22, "retract_r": 22,
     "distance_absolute": 21, "distance_incremental": 21,
     "arc_distance_absolute": 21, "arc_distance_incremental": 21,
     "set_position": 23, "clear_position_offset": 23, "suspend_position_offset": 23,
     "restore_position_offset": 23, "home": 23, "home_secondary": 23,
     "store_home": 23, "store_home_secondary": 23, "coordinate_data": 23, "local_offset": 23,
     "machine_coordinates": 24, "rapid": 24, "linear": 24, "arc_cw": 24, "arc_ccw": 24,
-    "probe": 24, "cancel_cycle": 24,
+    "probe": 24, "cancel_cycle": 24, **dict.fromkeys(CYCLES, 24),
     "program_stop": 25, "optional_stop": 25, "program_end": 25,
 }
 _RANK_OTHER_M = 13

@@ -1,0 +1,137 @@
+"""Emulate stage: canned cycles (G73, G81-G83, G85, G86, G89) as plain moves.
+
+Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
+
+* The cycle's plane picks the drilling axis (Z for G17, Y for G18, X for
+  G19); "Z" below means that axis, "XY" the two others.
+* R, Z, P and Q stay in force while the cycle mode lasts; a later block with
+  only X/Y drills again at the new place.
+* Absolute mode: R and Z are coordinates.  Incremental mode (G91): R is
+  measured from the tool's Z before the block, Z from R, and X/Y are
+  increments repeated L times.
+* Before the first hole, if the tool is below R, it rapids up to R.  At each
+  hole: rapid over the hole, rapid down to R, the cycle's own moves, then a
+  rapid retract to the clear height: the Z before the block (G98, if that is
+  above R) or R (G99).
+* G83 pecks Q deeper each time, rapids back to R, then rapids back down to
+  ``delta`` above the last depth; G73 only backs off by ``delta``.  LinuxCNC's
+  ``delta`` is 0.010 in (0.254 mm).
+
+Each move is returned as a :class:`Step`; the machine turns them into
+waypoints of the block.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..parse.table import MOTION_LINEAR, MOTION_RAPID
+from .arcs import PLANES
+
+CYCLES = frozenset({"cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
+                    "cycle_bore_stop", "cycle_bore_dwell"})
+PECK_DELTA_MM = 0.254  # LinuxCNC's G73/G83 back-off and approach, 0.010 in
+
+
+@dataclass
+class Step:
+    """One move of a cycle (machine coordinates, mm) and an optional dwell after it."""
+
+    point: np.ndarray
+    motion: int
+    dwell: float = 0.0
+
+
+@dataclass
+class CycleState:
+    """The sticky words of the cycle mode (program units converted to mm)."""
+
+    name: str = ""
+    r: float | None = None
+    z: float | None = None
+    p: float = 0.0
+    q: float | None = None
+    retract_to_r: bool = False  # G99
+
+
+def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarray, program: np.ndarray,
+              offset: np.ndarray, scale: np.ndarray, plane: int, incremental: bool, dwell_unit: float) -> list[Step]:
+    """Moves of one canned-cycle block (``params`` as written, in program units).
+
+    Raises
+    ------
+    ValueError
+        With the interpreter's reason (no R or Z in force, Q not positive, ...).
+    """
+    if name:
+        cycle.name = name
+    (a, b, axis), _ = PLANES[plane]
+    letter = "XYZ"[axis]
+    first, second = "XYZ"[a], "XYZ"[b]
+    if "R" in params:
+        cycle.r = params["R"] * scale[axis]
+    if letter in params:
+        cycle.z = params[letter] * scale[axis]
+    if "P" in params:
+        cycle.p = params["P"] * dwell_unit
+    if "Q" in params:
+        cycle.q = params["Q"] * scale[axis]
+    if cycle.r is None or cycle.z is None:
+        raise ValueError(f"canned cycle needs R and {letter} (none in force)")
+    repeats = int(params.get("L", 1))
+    if repeats < 1:
+        return []
+    old = program[axis]  # the drilling axis before the block, program coordinates
+    r = old + cycle.r if incremental else cycle.r
+    bottom = r + cycle.z if incremental else cycle.z
+    if cycle.name in ("cycle_peck", "cycle_chip_break") and not (cycle.q and cycle.q > 0):
+        raise ValueError("G73/G83 need a positive Q")
+    clear = r if cycle.retract_to_r or old < r else old
+    to_machine = offset[axis]
+    steps: list[Step] = []
+    here = position.copy()
+
+    def go(coord: float, motion: int, dwell: float = 0.0) -> None:
+        here[axis] = coord + to_machine
+        steps.append(Step(here.copy(), motion, dwell))
+
+    if old < r:  # preliminary move up to the R plane
+        go(r, MOTION_RAPID)
+    target = program.copy()
+    for _ in range(repeats):
+        for ax, word in ((a, first), (b, second)):
+            if word in params:
+                target[ax] = target[ax] + params[word] * scale[ax] if incremental else params[word] * scale[ax]
+        if (here[[a, b]] != target[[a, b]] + offset[[a, b]]).any():
+            here[[a, b]] = target[[a, b]] + offset[[a, b]]
+            steps.append(Step(here.copy(), MOTION_RAPID))
+        if here[axis] != r + to_machine:
+            go(r, MOTION_RAPID)
+        _drill(cycle, r, bottom, clear, go)
+    return steps
+
+
+def _drill(cycle: CycleState, r: float, bottom: float, clear: float, go) -> None:
+    """The moves after reaching R, ending at the clear height."""
+    name = cycle.name
+    if name in ("cycle_peck", "cycle_chip_break"):
+        depth = r
+        while depth > bottom:
+            start = depth if name == "cycle_chip_break" or depth == r else depth + PECK_DELTA_MM
+            if start != depth:
+                go(start, MOTION_RAPID)  # G83: back down to just above the last depth
+            depth = max(depth - cycle.q, bottom)
+            go(depth, MOTION_LINEAR)
+            if depth > bottom:
+                go(r if name == "cycle_peck" else depth + PECK_DELTA_MM, MOTION_RAPID)
+        go(clear, MOTION_RAPID)
+    elif name in ("cycle_bore", "cycle_bore_dwell"):
+        go(bottom, MOTION_LINEAR, cycle.p if name == "cycle_bore_dwell" else 0.0)
+        go(r, MOTION_LINEAR)
+        if clear != r:
+            go(clear, MOTION_RAPID)
+    else:  # G81, G82 and G86 feed in and rapid out
+        go(bottom, MOTION_LINEAR, cycle.p if name in ("cycle_drill_dwell", "cycle_bore_stop") else 0.0)
+        go(clear, MOTION_RAPID)
