@@ -8,7 +8,7 @@ units, which the caller states (rs274 run standalone reads them in inches).
 Examples
 --------
 >>> table = ToolTable.parse("T1 P1 Z0.5 D0.125 ;end mill\\n", units="inch")
->>> table[1].offset[2], table[1].diameter
+>>> float(table[1].offset[2]), table[1].diameter
 (12.7, 3.175)
 """
 
