@@ -8,8 +8,8 @@ come within 1 % of it using only those limits.
 
 from __future__ import annotations
 
+import gzip
 import math
-import os
 import re
 from pathlib import Path
 
@@ -18,9 +18,9 @@ import pytest
 
 import gcodekit
 from gcodekit.emulate.planners import planner_settings
-from gcodekit.emulate.planners import marlin
+from gcodekit.emulate.planners import grbl, marlin
 from gcodekit.emulate.planners.base import firmware_moves
-from gcodekit.emulate.planners.klipper import _speed_factor
+from gcodekit.emulate.planners.base import speed_factor as _speed_factor
 from gcodekit.parse.table import NAME_ID
 
 CASES = Path(__file__).parent / "golden" / "klipper" / "cases"  # cube20_marlin2.gcode lives there
@@ -37,7 +37,7 @@ def corpus_file(name: str) -> Path:
 
 def slicer_estimate(path: Path) -> float:
     """PrusaSlicer's "estimated printing time (normal mode)" from the file's footer, in seconds."""
-    opener = __import__("gzip").open if path.suffix == ".gz" else open
+    opener = gzip.open if path.suffix == ".gz" else open
     with opener(path, "rt", encoding="utf-8") as f:
         for line in f:
             if line.startswith("; estimated printing time (normal mode)"):
@@ -62,8 +62,7 @@ def test_prusaslicer_estimate_within_1_percent(name):
     assert total == pytest.approx(slicer_estimate(path), rel=0.01)
 
 
-@pytest.mark.skipif(not os.environ.get("GCODEKIT_SLOW"), reason="3.1 M lines, ~25 s; set GCODEKIT_SLOW=1")
-def test_plate150_within_1_percent():
+def test_plate150_within_1_percent():  # 3.1 M lines: about 13 s
     path = corpus_file("plate150_marlin2.gcode.gz")
     total = gcodekit.gcode_to_operation(path, "marlin").get_statistics()["time_s"]
     assert total == pytest.approx(slicer_estimate(path), rel=0.01)
@@ -125,8 +124,8 @@ def test_classic_jerk_right_angle_runs_at_the_jerk():
 def test_classic_jerk_shallow_corner():
     # a 30 degree turn at 50 mm/s: X changes by 50 (1 - cos 30) = 6.7 mm/s, Y by
     # 50 sin 30 = 25 mm/s > 10, so the shared speed scales by 10/25 to 20 mm/s
-    moves, result = plan_text("M205 X10 Y10\nM204 T1000\nG1 X100 F3000\n"
-                              f"G1 X{100 + 100 * math.cos(math.radians(30)):.6f} Y{100 * math.sin(math.radians(30)):.6f}\n")
+    x, y = 100 + 100 * math.cos(math.radians(30)), 100 * math.sin(math.radians(30))
+    moves, result = plan_text(f"M205 X10 Y10\nM204 T1000\nG1 X100 F3000\nG1 X{x:.6f} Y{y:.6f}\n")
     assert result.end_v[0] == pytest.approx(20.0, rel=1e-5)
 
 
@@ -147,6 +146,20 @@ def test_dwell_brings_marlin_to_rest():
     assert through.end_v[0] == pytest.approx(50.0)
     assert stopped.end_v[0] == pytest.approx(0.05)
     assert stopped.start_v[1] == pytest.approx(10.0)
+
+
+def test_restart_after_rest_is_not_limited_by_the_move_before():
+    # a 0.01 mm crawl ends the queue; after G4 the next move starts at its jerk speed
+    # (10 mm/s), not at what accelerating over the crawl would allow (~4.6 mm/s)
+    moves, result = plan_text("M205 X10\nM204 T1000\nG1 X0.01 F60\nG4 P0\nG1 X100 F3000\n")
+    assert result.start_v[1] == pytest.approx(10.0)
+
+
+def test_dwell_times_add_to_the_plan():
+    # at the end of the program the machine is at rest anyway: G4 only adds its time (P ms, S s)
+    base = gcodekit.gcode_to_operation("G1 X100 F3000\n", "marlin").get_statistics()["time_s"]
+    dwell = gcodekit.gcode_to_operation("G1 X100 F3000\nG4 P500\nG4 S1\n", "marlin").get_statistics()["time_s"]
+    assert dwell - base == pytest.approx(1.5)
 
 
 def test_single_move_trapezoid_by_hand():
@@ -251,7 +264,7 @@ def oracle(op, config: marlin.MarlinConfig):
                 for letter, key in (("J", "junction_deviation"), ("S", "min_feedrate"), ("T", "min_travel_feedrate")):
                     if letter in p:
                         s[key] = p[letter]
-        last_row = int(moves.row[i]) - 1 if i + 1 < len(moves) and moves.row[i + 1] == moves.row[i] else int(moves.row[i])
+        last_row = int(moves.row[i])  # chords of one arc share its row: nothing between them
         block = populate_block(moves.axes_d[i], float(moves.speed_v[i]), s, config, None if rest else previous)
         block["rest_before"] = rest
         blocks.append(block)
@@ -422,8 +435,11 @@ G1 X15 Y12 Z2 F600
 """
 
 
+@pytest.mark.parametrize("block", [1 << 16, 7], ids=["one_block", "blocks_of_7"])
 @pytest.mark.parametrize("classic_jerk", [True, False], ids=["classic_jerk", "junction_deviation"])
-def test_vectorized_plan_matches_the_oracle(classic_jerk):
+def test_vectorized_plan_matches_the_oracle(classic_jerk, block, monkeypatch):
+    monkeypatch.setattr(marlin, "BLOCK", block)  # element-wise steps run block by block
+    monkeypatch.setattr(grbl, "BLOCK", block)
     config = marlin.MarlinConfig(classic_jerk=classic_jerk)
     op = gcodekit.gcode_to_operation(ORACLE_PROGRAM, "marlin", plan=False)
     moves, result = marlin.plan(op, config)

@@ -101,6 +101,8 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
         go(r, MOTION_RAPID)
     target = program.copy()
     for _ in range(repeats):
+        if "@" in params or "^" in params:
+            target[[0, 1]] = polar_target(params, target[[0, 1]], scale[0], incremental)
         for ax, word in ((a, first), (b, second)):
             if word in params:
                 target[ax] = target[ax] + params[word] * scale[ax] if incremental else params[word] * scale[ax]
@@ -111,6 +113,17 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
             go(r, MOTION_RAPID)
         _drill(cycle, r, bottom, clear, go)
     return steps
+
+
+def polar_target(params: dict, xy: np.ndarray, scale: float, incremental: bool) -> np.ndarray:
+    """X/Y from LinuxCNC's polar words: ``@`` distance, ``^`` angle (degrees) about
+    the origin; a missing word keeps the point's own, G91 adds to them."""
+    radius, angle = float(np.hypot(*xy)), float(np.degrees(np.arctan2(xy[1], xy[0])))
+    if "@" in params:
+        radius = radius + params["@"] * scale if incremental else params["@"] * scale
+    if "^" in params:
+        angle = angle + params["^"] if incremental else params["^"]
+    return np.array([radius * np.cos(np.radians(angle)), radius * np.sin(np.radians(angle))])
 
 
 def _drill(cycle: CycleState, r: float, bottom: float, clear: float, go) -> None:

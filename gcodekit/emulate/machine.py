@@ -20,9 +20,9 @@ from ..errors import Diagnostics
 from ..parse.commands import Kind
 from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, NAME_ID, CommandTable
 from . import arcs
-from .modal import SPECIAL_NAMES, ModalHandler, Waypoint
+from .modal import ModalHandler, Waypoint
 from .presets import MachineConfig
-from .state import AXES, LINEAR, MachineState
+from .state import AXES, MachineState
 from .tooltable import ToolTable
 
 #: Float columns of the waypoint table, with their meaning and unit.
@@ -94,6 +94,9 @@ class Machine:
         special = np.isin(table.name, self.modal.special_ids) | (table.letter == ord("T"))
         special |= table.kind == Kind.MACHINE_COORDINATES
         special |= (table.motion == MOTION_CYCLE) & np.isin(table.kind, _MOVING)
+        for letter in "@^":  # polar words depend on where the tool is: one block at a time
+            if letter in table.params:
+                special |= ~np.isnan(table.param(letter)) & np.isin(table.kind, _MOVING)
         if self.config.block_delete and table.deleted.size:
             special[table.deleted] = True
         extra: list[tuple[int, Waypoint]] = []

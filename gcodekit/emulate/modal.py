@@ -16,7 +16,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..parse.table import MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, NAMES, CommandTable
-from .cycles import CYCLES, run_cycle
+from ..parse.commands import Kind
+from .cycles import CYCLES, polar_target, run_cycle
 from .state import AXES, MachineState
 from .tooltable import Tool
 
@@ -35,6 +36,7 @@ SPECIAL_NAMES = frozenset(
     coordinate_data local_offset retract_initial retract_r""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)}
 
+_MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
 _SIMPLE = {
     "units_inch": ("units", 25.4), "units_mm": ("units", 1.0),
     "distance_absolute": ("incremental", False), "distance_incremental": ("incremental", True),
@@ -78,8 +80,11 @@ class ModalHandler:
             return []
         if "F" in params and (chr(int(t.letter[row])) != "M" or self.machine.feed_in_any_block):
             s.feed = params["F"] * s.units
-        if int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
+        moves = int(t.kind[row]) in _MOVING_KINDS
+        if moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
             motion, extra = self._cycle(name, params, line)
+        elif moves and ("@" in params or "^" in params):
+            motion = self._polar_move(params, int(t.motion[row]), line)
         elif name in ("retract_initial", "retract_r"):
             s.cycle.retract_to_r = name == "retract_r"
         elif name in _SIMPLE:
@@ -181,6 +186,22 @@ class ModalHandler:
         s.position = steps[-1].point.copy()
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
+
+    def _polar_move(self, params: dict, motion: int, line: int) -> int:
+        """G0/G1 with ``@``/``^``: the X/Y end point in polar form (LinuxCNC, XY plane only)."""
+        s = self.state
+        if motion not in (MOTION_RAPID, MOTION_LINEAR) or s.plane != 17:
+            self.machine.diagnostics.report(line, 1, "polar words need G0 or G1 in the XY plane", kind="machine")
+            return MOTION_NONE
+        program = s.program_position()
+        scale = s.scale()
+        program[[0, 1]] = polar_target(params, program[[0, 1]], scale[0], s.incremental)
+        for ax, letter in enumerate(AXES):
+            if letter in params and letter not in "XY":
+                program[ax] = program[ax] + params[letter] * scale[ax] if s.incremental else params[letter] * scale[ax]
+        s.position = program + s.offset
+        s.program_shift[:] = 0.0
+        return motion
 
     def _coordinate_data(self, params: dict, line: int) -> None:
         """G10: L2/L20 set a work offset, L1/L10/L11 a tool's offsets (LinuxCNC 2.9)."""

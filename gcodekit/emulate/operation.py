@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import Diagnostics
 from ..parse.commands import Command, Kind
-from ..parse.table import MOTION_NAMES, NAMES, CommandTable
+from ..parse.table import MOTION_NAMES, CommandTable
 from ..syntax.flavor import code_label
 from .machine import FLOAT_COLUMNS, SMALL_COLUMNS
 from .state import MM_PER_INCH
@@ -186,7 +186,6 @@ class Operation:
         return np.flatnonzero(last)
 
     def _process_data(self, i: int) -> ProcessData:
-        w = self.waypoints
         mapping = self._waypoint_of_command()
         k = i if mapping is None else int(mapping[i])
         return self.process_data_class(**self._process_fields(k))

@@ -28,7 +28,10 @@ from .table import CYCLE_NAMES, MOTION_CYCLE, MOTION_NONE, MOTION_OF_NAME, NAME_
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
 _KEEP = 255  # "this row does not set the motion mode"
-_AXIS_IDX = np.array([ord(c) - 65 for c in sorted(AXIS_LETTERS)])
+#: Parameter letters and their row in the per-chunk parameter table.
+PARAM_LETTERS = "ABCDEFGHIJKLMNOPQRSTUVWXYZ@^"
+_LETTER_ROW = np.full(256, -1, np.int64)
+_LETTER_ROW[[ord(c) for c in PARAM_LETTERS]] = np.arange(len(PARAM_LETTERS))
 
 
 class GcodeParser:
@@ -60,7 +63,7 @@ class GcodeParser:
     def parse(self, blocks: Blocks) -> CommandTable:
         """Commands of ``blocks``, continuing the modal state of earlier calls."""
         n_blocks = len(blocks)
-        wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
+        wb, wl = blocks.word_block, blocks.word_letter
         is_code = (wl == _G) | (wl == _M)
         is_param = ~is_code & (wl != self._n_letter)
         n_codes = np.bincount(wb[is_code], minlength=n_blocks)
@@ -148,7 +151,7 @@ class GcodeParser:
 
         pw = np.flatnonzero(is_param & simple[wb])
         prow = row_of_block[wb[pw]]
-        pletter = wl[pw].astype(np.int64) - 65
+        pletter = _LETTER_ROW[wl[pw]]
         # A lone T word is the command itself (printer tool change, RS274 tool select).
         t_words = pw[(wl[pw] == _T) & (letter[prow] == 0)]
         if t_words.size:
@@ -157,11 +160,12 @@ class GcodeParser:
             number[tr] = np.round(wv[t_words] * 10).astype(np.int32)
             keep = ~((wl[pw] == _T) & np.isin(prow, tr))
             pw, prow, pletter = pw[keep], prow[keep], pletter[keep]
-        table = np.full((26, n), np.nan)
+        rows = len(PARAM_LETTERS)
+        table = np.full((rows, n), np.nan)
         table[pletter, prow] = wv[pw]
         self._first_of_repeats(blocks, table, pw, prow, pletter, n)
-        present = np.flatnonzero(np.bincount(pletter, minlength=26))
-        params = {chr(65 + k): table[k].copy() for k in present}
+        present = np.flatnonzero(np.bincount(pletter, minlength=rows))
+        params = {PARAM_LETTERS[k]: table[k].copy() for k in present}
         return {
             "block": rows_blocks,
             "sub": np.zeros(n, np.int32),
@@ -174,14 +178,15 @@ class GcodeParser:
         """A letter given twice in a block: report it and keep the first value."""
         if not pw.size:
             return
-        counts = np.bincount(prow * 26 + pletter, minlength=n_rows * 26)
+        width = len(PARAM_LETTERS)
+        counts = np.bincount(prow * width + pletter, minlength=n_rows * width)
         for key in np.flatnonzero(counts > 1).tolist():
-            row, k = divmod(key, 26)
+            row, k = divmod(key, width)
             words = pw[(prow == row) & (pletter == k)]
             table[k, row] = blocks.word_value[words[0]]
             line = int(blocks.block_line[blocks.word_block[words[1]]])
             self.diagnostics.report(line, int(blocks.word_col[words[1]]),
-                                    f"more than one {chr(65 + k)} word in the block; the first is used",
+                                    f"more than one {PARAM_LETTERS[k]} word in the block; the first is used",
                                     severity="error" if self._modal else "warning")
 
     # -- compound blocks ------------------------------------------------------
@@ -274,7 +279,7 @@ class GcodeParser:
                     out |= ~np.isnan(params[c])
             return out
 
-        has_axes, has_e, has_s, has_f = has("XYZABCUVW"), has("E"), has("S"), has("F")
+        has_axes, has_e, has_s, has_f = has("XYZABCUVW@^"), has("E"), has("S"), has("F")
         arc = (motion == 3) | (motion == 4)
         has_axes |= arc & has("IJKR")  # "G2 I5" is a full circle from where the tool is
         is_motion_name = np.isin(name, [NAME_ID[m] for m in MOTION_OF_NAME]) | np.isin(name, self._cycle_ids)

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from ..syntax import Flavor
 from ..syntax.flavor import code_label
 
-AXIS_LETTERS = frozenset("XYZABCUVW")
+AXIS_LETTERS = frozenset("XYZABCUVW@^")  # @ and ^: LinuxCNC's polar X/Y
 CYCLES = frozenset({"cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
                     "cycle_bore_stop", "cycle_bore_dwell"})
 #: Commands that take axis words in the same block.

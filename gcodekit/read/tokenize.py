@@ -107,7 +107,8 @@ class LineTokenizer:
             elif c == "*" and fl.checksum:
                 self._check_sum(text, i, line)
                 i = self._skip_checksum(text, i)
-            elif c.isalpha() and c.isascii() and (c.isupper() or not fl.case_sensitive):
+            elif (c.isalpha() and c.isascii() and (c.isupper() or not fl.case_sensitive)) or (
+                    c in "@^" and fl.polar_words):
                 i = self._word(text, i, block)
             else:
                 hint = ""

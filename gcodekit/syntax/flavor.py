@@ -132,6 +132,9 @@ class Flavor:
     code_assignments : bool
         A code may carry a value after ``=`` (Beckhoff ``M60=1``); the value
         becomes the command's ``value`` parameter.
+    polar_words : bool
+        ``@`` (distance) and ``^`` (angle, degrees) words give X and Y in polar
+        form (LinuxCNC).
     directive_prefix : str
         Lines starting with this text are controller directives kept as
         named commands (Beckhoff ``#TRAFO ON``); ``""`` for none.
@@ -178,6 +181,7 @@ class Flavor:
     wizards: bool = False
     code_assignments: bool = False
     directive_prefix: str = ""
+    polar_words: bool = False
     words: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     codes: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     units: str = "mm"

@@ -24,8 +24,9 @@ from .. import arcs
 if TYPE_CHECKING:
     from ..operation import Operation
 
-#: Chords of an arc: given the arc length in mm, how many segments.
-ArcRule = Callable[[np.ndarray], np.ndarray]
+#: Chords of each arc, from its length (mm), swept angle (rad), radius (mm)
+#: and requested speed (mm/s): how many segments.
+ArcRule = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
 
 @dataclass
@@ -96,6 +97,20 @@ def command_rows(op: "Operation", *, names: tuple[str, ...] = (), codes: tuple[s
     return np.flatnonzero(mask)
 
 
+def speed_factor(op: "Operation") -> np.ndarray:
+    """M220 S, as a ratio, in force at each waypoint (1 before any)."""
+    t = op.table
+    rows = command_rows(op, names=("set_speed_factor",))
+    w = op.waypoints
+    cmd = w["command"] if "command" in w else np.arange(len(w["x"]))
+    if rows.size == 0:
+        return np.ones(cmd.size)
+    values = t.param("S")[rows] / 100.0
+    values = np.where(np.isnan(values), 1.0, values)
+    k = np.searchsorted(rows, cmd, side="right") - 1
+    return np.where(k >= 0, values[np.maximum(k, 0)], 1.0)
+
+
 def in_force(moves: PlannerMoves, rows: np.ndarray, values: np.ndarray, initial: float) -> np.ndarray:
     """Per move, the last value set by a command row before the move's row."""
     if rows.size == 0:
@@ -125,8 +140,9 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     speed_factor : ndarray, optional
         Per waypoint multiplier of the feed (M220), 1 when None.
     arc_segments : callable, optional
-        Segment count from arc length; None keeps each arc as one move
-        along its chord (only for machines that do not segment).
+        Segment count from arc length, swept angle, radius and requested
+        speed (see :data:`ArcRule`); None keeps each arc as one move along
+        its chord (only for machines that do not segment).
     """
     w = op.waypoints
     n = w["x"].size
@@ -140,7 +156,8 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     for col in columns:  # compare with the previous waypoint column by column
         changed[:1] |= col[:1] != 0
         changed[1:] |= col[1:] != col[:-1]
-    idx = np.flatnonzero((w["motion"] > 0) & ~homing & changed)
+    full_circle = (w["motion"] >= 3) & (w["distance"] > 0)  # ends where it started
+    idx = np.flatnonzero((w["motion"] > 0) & ~homing & (changed | full_circle))
     end = np.empty((idx.size, 4))
     start = np.empty((idx.size, 4))
     before = idx - 1
@@ -181,7 +198,7 @@ def _with_segmented_arcs(w, idx, is_arc, move_start, move_end, speed, rows, arc_
         radius[sel] = np.hypot(*(s2 - c2).T)
     rise = end[np.arange(arc_idx.size), axes[:, 2]] - start[np.arange(arc_idx.size), axes[:, 2]]
     travel = np.hypot(radius * angle, rise)
-    counts[is_arc] = np.maximum(arc_segments(travel).astype(np.int64), 1)
+    counts[is_arc] = np.maximum(arc_segments(travel, angle, radius, speed[is_arc]).astype(np.int64), 1)
 
     total = int(counts.sum())
     owner = np.repeat(np.arange(idx.size), counts)

@@ -23,6 +23,7 @@ from __future__ import annotations
 import os
 import re
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -35,10 +36,10 @@ from .scans import backward_min, forward_min
 if TYPE_CHECKING:
     from ..operation import Operation
 
+BLOCK = 1 << 16  # element-wise steps run on this many moves at a time: less fresh memory
 MINIMUM_FEED_RATE = 1.0 / 60.0  # grbl config.h: MINIMUM_FEED_RATE 1.0 mm/min
 MINIMUM_JUNCTION_SPEED = 0.0  # grbl config.h, mm/s
 COS_STRAIGHT = 0.999999  # planner.c: |junction_cos_theta| beyond this is a reversal or a straight line
-ARC_ANGULAR_TRAVEL_EPSILON = 5e-7  # grbl config.h, rad
 
 #: ``$N`` numbers of the settings the planner reads, and their field names.
 SETTINGS = {
@@ -100,7 +101,7 @@ class GrblConfig:
         3000.0
         """
         try:
-            text = open(path, encoding="utf-8").read()
+            text = Path(path).read_text(encoding="utf-8")
         except OSError as exc:
             raise ConfigError(f"{path}: cannot read GRBL settings: {exc}") from exc
         values = {}
@@ -122,12 +123,13 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray, ar
     """Chords per arc as grbl's ``mc_arc`` cuts them.
 
     ``floor(|angle| * radius / 2 / sqrt(tol * (2 * radius - tol)))``, at
-    least one: each chord's sagitta stays within ``arc_tolerance``.
-    ``travel_d`` (helix length) does not enter: GRBL cuts by angle only.
+    least one: ``sqrt(tol * (2 r - tol))`` is half the chord whose sagitta
+    is ``tol``.  ``travel_d`` (helix length) does not enter: GRBL cuts by
+    the in-plane arc only.
     """
     with np.errstate(divide="ignore", invalid="ignore"):
-        chord_angle = np.sqrt(arc_tolerance * (2.0 * radius - arc_tolerance))
-        segments = np.floor(np.abs(0.5 * angle * radius) / chord_angle)
+        half_chord_d = np.sqrt(arc_tolerance * (2.0 * radius - arc_tolerance))
+        segments = np.floor(np.abs(0.5 * angle * radius) / half_chord_d)
     return np.maximum(np.nan_to_num(segments, nan=1.0, posinf=1.0), 1.0)
 
 
@@ -211,6 +213,15 @@ def trapezoid(move_d: np.ndarray, accel: np.ndarray, entry_v2: np.ndarray, nomin
     ramp).  An entry above what the move can brake from is clipped, as the
     firmware's step generator does.
     """
+    n = move_d.size
+    result = PlanResult(*(np.empty(n) for _ in range(7)))
+    for lo in range(0, n, BLOCK):
+        sl = slice(lo, min(lo + BLOCK, n))
+        _trapezoid_block(move_d[sl], accel[sl], entry_v2[sl], nominal_v2[sl], exit_v2[sl], result, sl)
+    return result
+
+
+def _trapezoid_block(move_d, accel, entry_v2, nominal_v2, exit_v2, result: PlanResult, sl: slice) -> None:
     half_inv_accel = 0.5 / accel
     accel_d = (nominal_v2 - entry_v2) * half_inv_accel
     decel_d = (nominal_v2 - exit_v2) * half_inv_accel
@@ -218,18 +229,17 @@ def trapezoid(move_d: np.ndarray, accel: np.ndarray, entry_v2: np.ndarray, nomin
     # where they meet: entry_v2 + 2 a x = exit_v2 + 2 a (d - x)
     meet_d = np.clip((move_d + (exit_v2 - entry_v2) * half_inv_accel) * 0.5, 0.0, move_d)
     accel_d = np.where(short, meet_d, np.maximum(accel_d, 0.0))
-    start_v2 = np.minimum(entry_v2, nominal_v2)
     cruise_v2 = np.where(short, entry_v2 + 2.0 * accel * meet_d, nominal_v2)
-    start_v2 = np.minimum(start_v2, cruise_v2)
+    start_v2 = np.minimum(np.minimum(entry_v2, nominal_v2), cruise_v2)
     decel_d = np.where(short, move_d - meet_d, np.clip(decel_d, 0.0, move_d - accel_d))
     end_v2 = np.maximum(cruise_v2 - 2.0 * accel * decel_d, 0.0)
     cruise_d = np.maximum(move_d - accel_d - decel_d, 0.0)
     start_v, cruise_v, end_v = np.sqrt(start_v2), np.sqrt(cruise_v2), np.sqrt(end_v2)
     with np.errstate(divide="ignore", invalid="ignore"):
-        accel_t = np.where(accel_d > 0, (cruise_v - start_v) / accel, 0.0)
-        cruise_t = np.where(cruise_d > 0, cruise_d / cruise_v, 0.0)
-        decel_t = np.where(decel_d > 0, (cruise_v - end_v) / accel, 0.0)
-    return PlanResult(start_v, cruise_v, end_v, accel, accel_t, cruise_t, decel_t)
+        result.accel_t[sl] = np.where(accel_d > 0, (cruise_v - start_v) / accel, 0.0)
+        result.cruise_t[sl] = np.where(cruise_d > 0, cruise_d / cruise_v, 0.0)
+        result.decel_t[sl] = np.where(decel_d > 0, (cruise_v - end_v) / accel, 0.0)
+    result.start_v[sl], result.cruise_v[sl], result.end_v[sl], result.accel[sl] = start_v, cruise_v, end_v, accel
 
 
 def empty_result() -> PlanResult:

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import ConfigError
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
+from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
 
 if TYPE_CHECKING:
@@ -197,8 +197,9 @@ BLOCK = 1 << 16
 
 def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResult]:
     """Plan an emulated operation as Klipper would; one result per firmware move."""
-    factor = _speed_factor(op)
-    moves = firmware_moves(op, factor, lambda mm: np.maximum(np.floor(mm / config.arc_resolution), 1.0))
+    factor = speed_factor(op)
+    # gcode_arcs.py: chords of at most `resolution` mm
+    moves = firmware_moves(op, factor, lambda mm, *_: np.maximum(np.floor(mm / config.arc_resolution), 1.0))
     n = len(moves)
     if n == 0:
         empty = np.zeros(0)
@@ -382,17 +383,4 @@ def _minimum(first: np.ndarray, *others: np.ndarray) -> np.ndarray:
         np.minimum(out, other, out=out)
     return out
 
-
-def _speed_factor(op: "Operation") -> np.ndarray:
-    """M220 S, as a ratio, in force at each waypoint."""
-    t = op.table
-    rows = command_rows(op, names=("set_speed_factor",))
-    w = op.waypoints
-    cmd = w["command"] if "command" in w else np.arange(len(w["x"]))
-    if rows.size == 0:
-        return np.ones(cmd.size)
-    values = t.param("S")[rows] / 100.0
-    values = np.where(np.isnan(values), 1.0, values)
-    k = np.searchsorted(rows, cmd, side="right") - 1
-    return np.where(k >= 0, values[np.maximum(k, 0)], 1.0)
 

@@ -32,14 +32,15 @@ from __future__ import annotations
 import os
 import re
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import ConfigError
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
-from .grbl import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
-from .klipper import _speed_factor
+from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
+from .grbl import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
+
 
 if TYPE_CHECKING:
     from ..operation import Operation
@@ -139,7 +140,7 @@ class MarlinConfig:
         (1500.0, 0.02, False)
         """
         try:
-            text = open(path, encoding="utf-8").read()
+            text = Path(path).read_text(encoding="utf-8")
         except OSError as exc:
             raise ConfigError(f"{path}: cannot read Marlin M503 report: {exc}") from exc
         values: dict[str, float | bool] = {}
@@ -197,11 +198,12 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray,
 
 
 def settings_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray, letter: str,
-                      initial: float, scale: float = 1.0) -> np.ndarray | float:
+                      initial: float, scale: float | np.ndarray = 1.0) -> np.ndarray | float:
     """Per move, the last value of word ``letter`` among ``rows`` before it (``initial`` before any).
 
-    A number when one value holds for every move (the common case: the
-    limits are set once at the top), else an array.
+    ``scale`` converts the word to the planner's unit (one factor, or one
+    per row).  Returns a number when one value holds for every move (the
+    common case: the limits are set once at the top), else an array.
     """
     values = op.table.param(letter)[rows] * scale
     given = ~np.isnan(values)
@@ -258,30 +260,54 @@ def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResul
     >>> round(float(result.start_v[0]), 3), round(float(result.duration_t[0]), 4)
     (10.0, 2.041)
     """
-    factor = _speed_factor(op)
+    factor = speed_factor(op)
     moves = firmware_moves(op, factor, lambda travel, angle, radius, speed_v: arc_segments(
         travel, angle, radius, config.max_arc_segment_mm, config.min_circle_segments))
     n = len(moves)
     if n == 0:
         return moves, empty_result()
     lim = _program_limits(op, moves, config)
-    axes_d = moves.axes_d
+    rest_before = happens_before(moves, command_rows(op, names=REST_NAMES))
+    rest_before[0] = True
+    block = {name: np.empty(n) for name in ("millimeters", "acceleration", "nominal_speed", "max_entry_speed_sqr")}
+    for lo in range(0, n, BLOCK):
+        _populate_blocks(moves, lim, rest_before, config, lo, min(lo + BLOCK, n), block)
+
+    millimeters, acceleration, nominal_speed = block["millimeters"], block["acceleration"], block["nominal_speed"]
+    minimum_planner_speed_sqr = config.minimum_planner_speed**2
+    delta_v2 = 2.0 * acceleration * millimeters
+    nominal_speed_sqr = nominal_speed * nominal_speed
+    # "If a block can de/ac-celerate from nominal speed to zero within the length of the block, then the
+    # current block and next block junction speeds are guaranteed to always be at their maximum"
+    nominal_length = nominal_speed_sqr <= minimum_planner_speed_sqr + delta_v2
+    rest_after = np.r_[rest_before[1:], True]
+    entry_speed_sqr, exit_speed_sqr = lookahead(block["max_entry_speed_sqr"], delta_v2, rest_after,
+                                                rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
+    return moves, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr)
+
+
+def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, config: MarlinConfig,
+                     lo: int, hi: int, out: dict) -> None:
+    """``_populate_block`` for moves ``lo:hi``: length, nominal speed, acceleration, junction speed."""
+    first = max(lo - 1, 0)  # the move before the block, for its junction
+    sl = slice(first, hi)
+    lim = {k: [_at(a, sl) for a in v] if isinstance(v, list) else _at(v, sl) for k, v in lim.items()}
+    axes_d = moves.end[sl] - moves.start[sl]
     dist_mm = [np.ascontiguousarray(axes_d[:, a]) for a in range(4)]  # X, Y, Z, E columns
     del axes_d
 
-    # _populate_block: length, nominal speed and per-axis speeds
     xyz_moves = (dist_mm[0] != 0) | (dist_mm[1] != 0) | (dist_mm[2] != 0)
     esteps = dist_mm[3] != 0
     xyz_mm, _ = unit_vectors(dist_mm[:3])
     millimeters = np.where(xyz_moves, xyz_mm, np.abs(dist_mm[3]))
-    del xyz_mm
-    fr_mm_s = np.maximum(np.nan_to_num(moves.speed_v), np.where(esteps, lim["min_feedrate"], lim["min_travel_feedrate"]))
-    fr_mm_s = np.maximum(fr_mm_s, config.minimum_planner_speed)  # a move without a feed rate still moves
+    fr_mm_s = np.maximum(np.nan_to_num(moves.speed_v[sl]),
+                         np.where(esteps, lim["min_feedrate"], lim["min_travel_feedrate"]))
+    # no feed rate yet (F0 or none): Marlin only plans positive speeds, so crawl at the stop speed
+    fr_mm_s = np.maximum(fr_mm_s, config.minimum_planner_speed)
     inverse_millimeters = 1.0 / millimeters
     # speed_factor: the largest fraction of fr_mm_s within every axis's max feed rate
     speed_factor = np.minimum(limit_by_axis_maximum(lim["max_feedrate"], dist_mm) * millimeters / fr_mm_s, 1.0)
     nominal_speed = fr_mm_s * speed_factor
-    del speed_factor, fr_mm_s
     # current_speed[i] = dist_mm[i] * inverse_secs, after the speed factor
     speed_per_mm = nominal_speed * inverse_millimeters
 
@@ -289,30 +315,26 @@ def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResul
     accel = np.where(esteps, lim["acceleration"], lim["travel_acceleration"])
     accel = np.minimum(accel, limit_by_axis_maximum(lim["max_acceleration"], dist_mm) * millimeters)
     acceleration = np.where(xyz_moves, accel, lim["retract_acceleration"])
-    del accel
 
-    rest_before = happens_before(moves, command_rows(op, names=REST_NAMES))
-    rest_before[0] = True
-    prev = np.r_[0, np.arange(n - 1)]
-    minimum_planner_speed_sqr = config.minimum_planner_speed**2
+    rest = rest_before[sl]
+    prev = np.r_[0, np.arange(hi - first - 1)]
     if config.classic_jerk:
-        vmax_junction = _classic_jerk(dist_mm, speed_per_mm, nominal_speed, lim["max_jerk"], prev, rest_before)
+        vmax_junction = _classic_jerk(dist_mm, speed_per_mm, nominal_speed, lim["max_jerk"], prev, rest)
         max_entry_speed_sqr = vmax_junction * vmax_junction
     else:
         max_entry_speed_sqr = _junction_deviation(dist_mm, esteps, inverse_millimeters, millimeters, nominal_speed,
                                                   acceleration, lim, prev, config)
-        max_entry_speed_sqr[rest_before] = minimum_planner_speed_sqr
-    del dist_mm
+        max_entry_speed_sqr[rest] = config.minimum_planner_speed**2
+    k = lo - first
+    out["millimeters"][lo:hi] = millimeters[k:]
+    out["acceleration"][lo:hi] = acceleration[k:]
+    out["nominal_speed"][lo:hi] = nominal_speed[k:]
+    out["max_entry_speed_sqr"][lo:hi] = max_entry_speed_sqr[k:]
 
-    delta_v2 = 2.0 * acceleration * millimeters
-    nominal_speed_sqr = nominal_speed * nominal_speed
-    # "If a block can de/ac-celerate from nominal speed to zero within the length of the block, then the
-    # current block and next block junction speeds are guaranteed to always be at their maximum"
-    nominal_length = nominal_speed_sqr <= minimum_planner_speed_sqr + delta_v2
-    rest_after = np.r_[rest_before[1:], True]
-    entry_speed_sqr, exit_speed_sqr = lookahead(max_entry_speed_sqr, delta_v2, rest_after,
-                                                rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
-    return moves, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr)
+
+def _at(value, sl: slice):
+    """A limit for the moves in ``sl``: a number stays a number."""
+    return value[sl] if isinstance(value, np.ndarray) else value
 
 
 def _classic_jerk(dist_mm, speed_per_mm, nominal_speed, max_jerk, prev, rest_before) -> np.ndarray:

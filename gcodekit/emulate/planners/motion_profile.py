@@ -105,7 +105,7 @@ def plan(op: "Operation", config: MotionProfileConfig) -> tuple[PlannerMoves, Pl
         return (PlannerMoves(np.zeros((0, 4)), np.zeros((0, 4)), empty, np.zeros(0, np.int64), np.zeros(0, np.int64)),
                 PlanResult(empty, empty, empty, empty, empty, empty, empty))
     resolution = config.arc_resolution
-    moves = firmware_moves(op, None, lambda mm: np.maximum(np.ceil(mm / resolution), 1.0))
+    moves = firmware_moves(op, None, lambda mm, *_: np.maximum(np.ceil(mm / resolution), 1.0))
     distance = np.asarray(w["distance"], float)
     time = np.asarray(w["time"], float)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -27,14 +27,15 @@ from __future__ import annotations
 import os
 import re
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import ConfigError
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
+from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .grbl import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
-from .klipper import _speed_factor
+
 from .marlin import settings_in_force
 
 if TYPE_CHECKING:
@@ -116,7 +117,7 @@ class RrfConfig:
         (60.0, 1, 3000.0)
         """
         try:
-            text = open(path, encoding="utf-8").read()
+            text = Path(path).read_text(encoding="utf-8")
         except OSError as exc:
             raise ConfigError(f"{path}: cannot read RepRapFirmware config.g: {exc}") from exc
         values: dict[str, float] = {}
@@ -181,23 +182,17 @@ def _program_limits(op: "Operation", moves: PlannerMoves, config: RrfConfig) -> 
     m201 = command_rows(op, names=("set_max_accel",))
     m203 = command_rows(op, names=("set_max_feed",))
     m204 = command_rows(op, names=("set_accel",))
-    jerk_rows = command_rows(op, names=("set_jerk",))
-    is_m566 = np.array([t.code(int(r)) == "M566" for r in jerk_rows], bool)
-    m566, m205 = jerk_rows[is_m566], jerk_rows[~is_m566]
+    m566 = command_rows(op, codes=("M566",))  # mm/min
+    m205 = command_rows(op, codes=("M205",))  # mm/s
 
     def per_axis(rows, name, scale):
         return [settings_in_force(op, moves, rows, a, v * scale, scale) for a, v in zip(AXES, config.axes(name))]
 
-    if m205.size and m566.size:  # both set the same limits: take them in program order, in mm/s
-        rows = np.sort(jerk_rows)
-        scale = np.where(np.isin(rows, m566), 1.0 / 60.0, 1.0)
-        instant_dv = []
-        for a, v in zip(AXES, config.axes("instant_dv")):
-            values = t.param(a)[rows] * scale
-            given = ~np.isnan(values)
-            instant_dv.append(in_force(moves, rows[given], values[given], v / 60.0))
-    else:
-        instant_dv = per_axis(m566, "instant_dv", 1.0 / 60.0) if m566.size else per_axis(m205, "instant_dv", 1.0)
+    # M566 (mm/min) and M205 (mm/s) set the same limits: take them in program order
+    jerk_rows = np.union1d(m566, m205)
+    jerk_scale = np.where(np.isin(jerk_rows, m566), 1.0 / 60.0, 1.0)
+    instant_dv = [settings_in_force(op, moves, jerk_rows, a, v / 60.0, jerk_scale)
+                  for a, v in zip(AXES, config.axes("instant_dv"))]
     limits = {
         "max_acceleration": per_axis(m201, "max_acceleration", 1.0),
         "max_feedrate": per_axis(m203, "max_feedrate", 1.0 / 60.0),
@@ -228,7 +223,7 @@ def plan(op: "Operation", config: RrfConfig) -> tuple[PlannerMoves, PlanResult]:
     >>> round(float(result.duration_t[0]), 3)
     0.54
     """
-    factor = _speed_factor(op)
+    factor = speed_factor(op)
     moves = firmware_moves(op, factor, lambda travel, angle, radius, speed_v: arc_segments(
         travel, angle, radius, speed_v, config))
     n = len(moves)
