@@ -1,0 +1,76 @@
+"""Command line: info (text and JSON), export, errors, progress bar."""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import pytest
+
+from gcodekit import cli
+
+EXAMPLES = Path(__file__).parents[1] / "examples"
+MILL = EXAMPLES / "bracket_mill.ngc"
+PRINT = EXAMPLES / "cube20_prusaslicer_marlin.gcode"
+
+
+def run(args, capsys):
+    status = cli.main([str(a) for a in args])
+    out = capsys.readouterr()
+    return status, out.out, out.err
+
+
+def test_info_json_has_the_documented_keys(capsys):
+    status, out, _ = run(["info", PRINT, "--json"], capsys)
+    record = json.loads(out)
+    assert status == 0
+    for key in ("file", "flavor", "machine", "lines", "moves", "bounds", "distance_mm", "time_s", "layers",
+                "filament_mm", "diagnostics"):
+        assert key in record
+    assert record["flavor"] == "marlin" and record["layers"] == 100
+    assert set(record["bounds"]) == {"min", "max"} and len(record["bounds"]["min"]) == 3
+    assert set(record["distance_mm"]) == {"feed", "rapid", "extrude"}
+    assert all({"line", "column", "severity", "message"} <= set(d) for d in record["diagnostics"])
+
+
+def test_info_text_for_several_files(capsys):
+    status, out, _ = run(["info", MILL, PRINT], capsys)
+    assert status == 0
+    assert "bracket_mill.ngc" in out and "cube20_prusaslicer_marlin.gcode" in out
+    assert "rs274ngc" in out and "layers     100" in out
+
+
+def test_export_csv_columns_and_no_overwrite(tmp_path, capsys):
+    target = tmp_path / "moves.csv"
+    status, _, _ = run(["export", MILL, "--to", "csv", "-o", target], capsys)
+    assert status == 0
+    header = target.read_text().splitlines()[0].split(",")
+    assert header[:13] == ["line", "motion", "x", "y", "z", "a", "b", "c", "feed", "cx", "cy", "cz", "plane"]
+    status, _, err = run(["export", MILL, "--to", "csv", "-o", target], capsys)
+    assert status == 2 and "--force" in err
+
+
+def test_errors_are_one_clear_line(capsys):
+    status, _, err = run(["info", "no/such/file.gcode"], capsys)
+    assert status == 2 and err.startswith("gcodekit: error: no such file")
+    status, _, err = run(["info", MILL, "--machine", "linuxcnk"], capsys)
+    assert status == 2 and "did you mean 'linuxcnc'" in err
+
+
+def test_strict_mode_reports_the_location(tmp_path, capsys):
+    bad = tmp_path / "bad.ngc"
+    bad.write_text("G21\nG1 X1 X2 F100\n")
+    status, _, err = run(["info", bad, "--strict"], capsys)
+    assert status == 1 and f"{bad}:2:7" in err
+
+
+def test_progress_bar_on_a_terminal(tmp_path, monkeypatch):
+    big = tmp_path / "big.gcode"
+    big.write_text(PRINT.read_text() * 14)  # > 2 MB, so the bar shows
+    stderr = io.StringIO()
+    stderr.isatty = lambda: True  # type: ignore[method-assign]
+    monkeypatch.setattr("sys.stderr", stderr)
+    monkeypatch.setattr("sys.stdout", io.StringIO())
+    assert cli.main(["info", str(big)]) == 0
+    assert "B/s" in stderr.getvalue() or "%|" in stderr.getvalue()
