@@ -17,6 +17,7 @@ from .emulate.operation import (
     SubtractiveOperation,
     SubtractiveProcessData,
 )
+from .emulate.exporters import GcodeExporter
 from .emulate.presets import MachineConfig, list_machines, load_machine
 from .errors import (
     ConfigError,
@@ -34,7 +35,7 @@ from .syntax import detect_flavor, list_flavors, load_flavor
 __version__ = "0.1.0"
 
 __all__ = [
-    "AdditiveOperation", "AdditiveProcessData", "ConfigError", "Diagnostic", "GcodeError",
+    "AdditiveOperation", "AdditiveProcessData", "ConfigError", "GcodeExporter", "Diagnostic", "GcodeError",
     "GcodeExpressionError", "GcodeLimitError", "GcodeMachineError", "GcodeParser", "GcodeSyntaxError",
     "MachineConfig", "Operation", "ProcessData", "SubtractiveOperation", "SubtractiveProcessData",
     "detect_flavor", "emulate_operation", "gcode_file_to_dataframe", "gcode_to_operation", "list_flavors",
