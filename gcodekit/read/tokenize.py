@@ -181,7 +181,8 @@ class LineTokenizer:
                 return end
             if digits and j < n and (text[j] in "._" or text[j].isalnum()):
                 end = j  # a version or name such as U3.13.0 is kept as text
-                while end < n and not text[end].isspace() and text[end] not in fl.line_comments:
+                while end < n and not text[end].isspace() and text[end] not in fl.line_comments and not (
+                        fl.checksum and text[end] == "*"):
                     end += 1
                 block.add_text(text[i:end])
                 return end
@@ -212,6 +213,10 @@ class LineTokenizer:
             if code in ("M117", "M118"):  # the message is the whole rest of the line
                 cut = -1
             arg = rest if cut < 0 else rest[:cut]
+            star = arg.rfind("*") if fl.checksum else -1
+            if star >= 0 and arg[star + 1:].strip().isdigit():  # Marlin strips the checksum first
+                self._check_sum(text, j + star, block.line)
+                arg = arg[:star]
             block.add_text(arg.strip())
             if cut >= 0:
                 block.comments.append((rest[cut + 1 :].strip(), j + cut + 1))
