@@ -213,7 +213,7 @@ def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineCon
 def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None) -> Iterator[tuple[Blocks, int]]:
     """Blocks of the program chunk by chunk, preprocessed when it needs it."""
     if flavor.parameters:
-        from .preprocess import ParameterStage, SourceLine, needs_parameters, run_stages
+        from .preprocess import ControlFlowStage, SourceLine, needs_parameters, run_stages
 
         text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
         if needs_parameters(text) or _O_WORD_LINE.search(text):
@@ -221,7 +221,7 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
             if lines and lines[-1] == "":
                 lines.pop()
             source = (SourceLine(t.rstrip("\r"), k + 1, program.name) for k, t in enumerate(lines))
-            out = run_stages(source, [ParameterStage(flavor)], diagnostics)
+            out = run_stages(source, [ControlFlowStage(flavor)], diagnostics)
             yield read_source_lines(out, flavor, diagnostics), len(lines)
             return
         chunks: Iterator[bytes] = iter_lines(text)

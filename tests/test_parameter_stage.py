@@ -311,8 +311,10 @@ def test_program_with_parameters_runs_through_the_pipeline():
     assert not [d for d in op.diagnostics if d.severity == "error"]
 
 
-def test_o_word_flow_is_reported_even_without_parameters():
+def test_o_word_flow_runs_even_without_parameters():
     import gcodekit
 
-    op = gcodekit.gcode_to_operation("o100 sub\nG1 X1 F10\no100 endsub\n", "linuxcnc")
-    assert [d.line for d in op.diagnostics if "O-word" in d.message] == [1, 3]
+    op = gcodekit.gcode_to_operation("o100 sub\nG1 X1 F10\no100 endsub\no100 call\no100 call\n", "linuxcnc",
+                                     plan=False)
+    assert op.motions()["line"].tolist() == [2, 2]
+    assert not [d for d in op.diagnostics if d.severity == "error"]

@@ -10,8 +10,8 @@ Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
   measured from the tool's Z before the block, Z from R, and X/Y are
   increments repeated L times.
 * Before the first hole, if the tool is below R, it rapids up to R.  At each
-  hole: rapid over the hole, rapid down to R, the cycle's own moves, then a
-  rapid retract to the clear height: the Z before the block (G98, if that is
+  hole: rapid over the hole (even when already there), rapid down to R if
+  above it, the cycle's own moves, then a rapid retract to the clear height: the Z before the block (G98, if that is
   above R) or R (G99).
 * G83 pecks Q deeper each time, rapids back to R, then rapids back down to
   ``delta`` above the last depth; G73 only backs off by ``delta``.  LinuxCNC's
@@ -50,6 +50,7 @@ class CycleState:
 
     name: str = ""
     r: float | None = None
+    r_words: float = 0.0  # R as written, in the program's units
     z: float | None = None
     p: float = 0.0
     q: float | None = None
@@ -72,6 +73,7 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
     first, second = "XYZ"[a], "XYZ"[b]
     if "R" in params:
         cycle.r = params["R"] * scale[axis]
+        cycle.r_words = params["R"]
     if letter in params:
         cycle.z = params[letter] * scale[axis]
     if "P" in params:
@@ -83,12 +85,16 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
     repeats = int(params.get("L", 1))
     if repeats < 1:
         return []
-    old = program[axis]  # the drilling axis before the block, program coordinates
+    old = program[axis]  # the drilling axis before the block, program coordinates (mm)
     r = old + cycle.r if incremental else cycle.r
     bottom = r + cycle.z if incremental else cycle.z
     if cycle.name in ("cycle_peck", "cycle_chip_break") and not (cycle.q and cycle.q > 0):
         raise ValueError("G73/G83 need a positive Q")
     clear = r if cycle.retract_to_r or old < r else old
+    # rs274 compares in the program's units a position it keeps in mm: in an
+    # inch program a tool sitting at R after a cycle reads as just below R
+    # (2.54 / 25.4 < 0.1), so the next block starts with a zero-length rapid.
+    below_r = old / scale[axis] < (old / scale[axis] + cycle.r_words if incremental else cycle.r_words)
     to_machine = offset[axis]
     steps: list[Step] = []
     here = position.copy()
@@ -97,7 +103,7 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
         here[axis] = coord + to_machine
         steps.append(Step(here.copy(), motion, dwell))
 
-    if old < r:  # preliminary move up to the R plane
+    if below_r:  # preliminary move up to the R plane
         go(r, MOTION_RAPID)
     target = program.copy()
     for _ in range(repeats):
@@ -106,9 +112,8 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
         for ax, word in ((a, first), (b, second)):
             if word in params:
                 target[ax] = target[ax] + params[word] * scale[ax] if incremental else params[word] * scale[ax]
-        if (here[[a, b]] != target[[a, b]] + offset[[a, b]]).any():
-            here[[a, b]] = target[[a, b]] + offset[[a, b]]
-            steps.append(Step(here.copy(), MOTION_RAPID))
+        here[[a, b]] = target[[a, b]] + offset[[a, b]]  # rs274 emits it even when already there
+        steps.append(Step(here.copy(), MOTION_RAPID))
         if here[axis] != r + to_machine:
             go(r, MOTION_RAPID)
         _drill(cycle, r, bottom, clear, go)

@@ -1,7 +1,8 @@
 """Preprocess stage: text lines in, plain G-code lines out.
 
 Preprocessing rewrites a program's lines before they are read into words:
-parameters and expressions now; control flow, subprograms and wizards later.
+parameters and expressions (:mod:`.parameters`, :mod:`.expressions`), O-word
+control flow and subprograms (:mod:`.flow`); wizards later.
 Each step is a :class:`Stage` that maps a stream of :class:`SourceLine` to
 another, keeping every line's source file and 1-based line number so later
 diagnostics still point at what the user wrote.  :func:`run_stages` chains
@@ -18,6 +19,7 @@ from gcodekit.errors import Diagnostics, GcodeError
 from gcodekit.preprocess.expressions import evaluate as _evaluate
 from gcodekit.preprocess.expressions import parse
 from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, needs_parameters
+from gcodekit.preprocess.flow import ControlFlowStage
 
 
 @dataclass(frozen=True, slots=True)
@@ -106,4 +108,5 @@ __all__ = [
     "parse",
     "ParameterStore",
     "ParameterStage",
+    "ControlFlowStage",
 ]

@@ -13,7 +13,7 @@ import dataclasses
 import operator
 import re
 from decimal import Decimal
-from typing import TYPE_CHECKING, Callable, Iterable, Iterator
+from typing import TYPE_CHECKING, Callable, Iterable, Iterator, Sequence
 
 from gcodekit.errors import Diagnostics, GcodeError, GcodeExpressionError, GcodeLimitError
 from gcodekit.preprocess.expressions import (
@@ -35,6 +35,9 @@ if TYPE_CHECKING:
 #: Highest parameter number.  LinuxCNC's ``RS274NGC_MAX_PARAMETERS`` is 5602
 #: and it accepts numbers below it, 1 .. 5601.
 MAX_PARAMETER = 5601
+#: Numbered parameters local to an ``O- call``: #1 .. #30 (LinuxCNC
+#: ``INTERP_SUB_PARAMS``).
+CALL_PARAMETERS = 30
 
 #: ``system(key)`` gives a read-only system parameter (``5420``, ``"_x"``)
 #: or None when ``key`` is not one.
@@ -53,6 +56,11 @@ _SPACE = " \t\r\n\v\f"
 # (start, end, replacement) in the line's text, in order; and (key, value).
 _Edits = list[tuple[int, int, str]]
 _Assignments = list[tuple[int | str, float]]
+# A line's values, parsed once: (start, end, value node, assignment target
+# or None, column of the assignment).
+_Plan = list[tuple[int, int, Node, "Node | None", int]]
+#: Lines whose parsed values a stage keeps, so loops do not parse again.
+PLAN_CACHE_SIZE = 4096
 
 
 def needs_parameters(text: str) -> bool:
@@ -81,8 +89,8 @@ class ParameterStore:
 
     Numbered parameters ``1`` .. :data:`MAX_PARAMETER` start at 0.0.  Named
     parameters are case-insensitive and ignore spaces; names starting with
-    ``_`` are global, the others local to the main program (subprograms
-    arrive with issue #4).
+    ``_`` are global, the others local to the running subroutine call (or
+    the main program): see :meth:`enter_call`.
 
     Parameters
     ----------
@@ -104,6 +112,8 @@ class ParameterStore:
         self._globals: dict[str, float] = {}
         self._locals: dict[str, float] = {}
         self._system = system
+        # One (caller's named locals, caller's #1..#30 or None) per open call.
+        self._calls: list[tuple[dict[str, float], list[float] | None]] = []
 
     def get(self, key: int | str) -> float:
         """Value of ``#key`` (int) or ``#<key>`` (str).
@@ -153,6 +163,33 @@ class ParameterStore:
     def read_only(self, key: int | str) -> bool:
         """Whether ``key`` is a system parameter (which :meth:`set` refuses)."""
         return self._system is not None and self._system(_normalize(key)) is not None
+
+    def enter_call(self, args: Sequence[float] | None = None) -> None:
+        """Open the scope of a subroutine call, as LinuxCNC ``execute_call``.
+
+        Named locals start empty.  With ``args`` (an ``O- call``), #1 ..
+        #:data:`CALL_PARAMETERS` are saved, #1 .. #len(args) take the
+        arguments and the rest keep the caller's values; with None (a Fanuc
+        ``M98`` call) the numbered parameters stay shared.
+        """
+        if args is not None and len(args) > CALL_PARAMETERS:
+            raise GcodeExpressionError(f"a call takes at most {CALL_PARAMETERS} arguments, not {len(args)}")
+        saved = None if args is None else self._numbered[1 : CALL_PARAMETERS + 1]
+        self._calls.append((self._locals, saved))
+        self._locals = {}
+        for number, value in enumerate(args or (), 1):
+            self._numbered[number] = float(value)
+
+    def leave_call(self) -> None:
+        """Close the innermost call scope: restore the caller's locals and #1 .. #30."""
+        self._locals, saved = self._calls.pop()
+        if saved is not None:
+            self._numbered[1 : CALL_PARAMETERS + 1] = saved
+
+    @property
+    def call_depth(self) -> int:
+        """Number of open subroutine calls (0 in the main program)."""
+        return len(self._calls)
 
     def _scope(self, name: str) -> dict[str, float]:
         return self._globals if name.startswith("_") else self._locals
@@ -220,6 +257,7 @@ class ParameterStage:
         if flavor.paren_comments:
             starts.append(r"\(")
         self._comment = re.compile("|".join(starts)) if starts else None
+        self._plans: dict[str, _Plan] = {}
 
     def process(self, lines: Iterable[SourceLine], diagnostics: Diagnostics) -> Iterator[SourceLine]:
         """Yield each line with its parameters substituted."""
@@ -238,6 +276,16 @@ class ParameterStage:
         if o_word:
             diagnostics.report(line.line, o_word.start(1) + 1, O_WORD_MESSAGE, text, kind="syntax")
             return dataclasses.replace(line, text="")
+        return self.substitute(line, diagnostics)
+
+    def substitute(self, line: SourceLine, diagnostics: Diagnostics) -> SourceLine:
+        """``line`` with its values substituted and its assignments applied.
+
+        For a line that is not an O-word line; the control-flow stage calls
+        this for each line it executes.  Errors are reported as by
+        :meth:`process` and empty the line.
+        """
+        text = line.text
         if not needs_parameters(text):
             return line
         try:
@@ -250,10 +298,24 @@ class ParameterStage:
         return line if new == text else dataclasses.replace(line, text=new)
 
     def _substitute(self, text: str) -> str:
+        plan = self._plans.get(text)
+        if plan is None:
+            plan = []
+            for start, end in self.code_ranges(text):
+                self._scan(compact(text, start, end), text, plan)
+            if len(self._plans) < PLAN_CACHE_SIZE:
+                self._plans[text] = plan
         edits: _Edits = []
         assignments: _Assignments = []
-        for start, end in self._code_ranges(text):
-            self._scan(compact(text, start, end), text, edits, assignments)
+        for start, end, node, target, column in plan:
+            if target is None:
+                edits.append((start, end, format_number(evaluate(node, self.store))))
+                continue
+            key = self._key(target)
+            if self.store.read_only(key):
+                raise expression_error(f"parameter {_show(key)} is read-only", column)
+            assignments.append((key, evaluate(node, self.store)))
+            edits.append((start, end, ""))
         # RS274NGC sets parameters in parallel: only now that every value on
         # the line has been read.
         for key, value in assignments:
@@ -270,7 +332,7 @@ class ParameterStage:
             result = result.rstrip(_SPACE)
         return "" if result.strip(_SPACE) == "" else result
 
-    def _code_ranges(self, text: str) -> list[tuple[int, int]]:
+    def code_ranges(self, text: str) -> list[tuple[int, int]]:
         """``(start, end)`` of the parts of ``text`` outside comments."""
         ranges, pos = [], 0
         while self._comment is not None:
@@ -285,17 +347,17 @@ class ParameterStage:
         ranges.append((pos, len(text)))
         return ranges
 
-    def _scan(self, code: CompactText, text: str, edits: _Edits, assignments: _Assignments) -> None:
+    def _scan(self, code: CompactText, text: str, plan: _Plan) -> None:
         """Find the values to replace and the assignments in one code range."""
         s, i = code.chars, 0
         while i < len(s):
             c = s[i]
             if c == "#":
-                i = self._assignment(code, i, text, edits, assignments)
+                i = self._assignment(code, i, text, plan)
             elif c == "[":
                 message = "an expression must be the value of a word, as in X[...]"
                 raise expression_error(message, code.column(i))
-            elif "a" <= c <= "z":
+            elif "a" <= c <= "z" or (c in "@^" and self.flavor.polar_words):  # @ ^: polar words
                 run = i + 1
                 while run < len(s) and "a" <= s[run] <= "z":
                     run += 1
@@ -304,28 +366,21 @@ class ParameterStage:
                     continue
                 start = i + 1
                 node, i = parse_value(code, start)
-                value = format_number(evaluate(node, self.store))
-                edits.append((code.column(start), code.column(i - 1) + 1, value))
+                plan.append((code.column(start), code.column(i - 1) + 1, node, None, 0))
             else:
                 i += 1
 
-    def _assignment(
-        self, code: CompactText, pos: int, text: str, edits: _Edits, assignments: _Assignments
-    ) -> int:
+    def _assignment(self, code: CompactText, pos: int, text: str, plan: _Plan) -> int:
         """Read ``#target = value`` at ``pos``; return the position after it."""
         s = code.chars
         target, eq = parse_value(code, pos)
         if not s.startswith("=", eq):
             raise expression_error("'=' expected: a parameter here must be assigned", code.column(eq))
         node, end = parse_value(code, eq + 1)
-        key = self._key(target)
-        if self.store.read_only(key):
-            raise expression_error(f"parameter {_show(key)} is read-only", code.column(pos))
-        assignments.append((key, evaluate(node, self.store)))
         stop = code.column(end - 1) + 1
         while stop < len(text) and text[stop] in _SPACE:
             stop += 1
-        edits.append((code.column(pos), stop, ""))
+        plan.append((code.column(pos), stop, node, target, code.column(pos)))
         return end
 
     def _key(self, target: Node) -> int | str:

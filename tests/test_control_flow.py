@@ -1,0 +1,358 @@
+"""Preprocess stage: O-word control flow executed into plain lines.
+
+Semantics follow LinuxCNC 2.9 (``interp_o_word.cc`` and the O Codes page):
+subroutines with local #1..#30 and named locals, return values in
+``#<_value>``, loops, conditionals, subroutine files, Fanuc M98/M99, and
+limits that end runaway programs with an error naming the line.
+"""
+
+import time
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gcodekit.errors import Diagnostics, GcodeError, GcodeLimitError, GcodeSyntaxError
+from gcodekit.preprocess import ControlFlowStage, ParameterStore, SourceLine
+from gcodekit.syntax import load_flavor
+from gcodekit.syntax.flavor import Flavor
+
+NGC = Flavor("ngc", line_comments=(";",), paren_comments=True, parameters=True)
+
+
+def run(program: str, *, mode: str = "strict", file: str = "t.ngc", **options):
+    """``[(line, text), ...]`` emitted, and the diagnostics."""
+    diagnostics = Diagnostics(file, mode=mode)
+    lines = [SourceLine(t, n, file) for n, t in enumerate(program.strip("\n").split("\n"), 1)]
+    stage = ControlFlowStage(options.pop("flavor", NGC), **options)
+    out = [(s.line, s.text) for s in stage.process(lines, diagnostics)]
+    return out, diagnostics
+
+
+def texts(program: str, **options) -> list[str]:
+    return [t for _, t in run(program, **options)[0]]
+
+
+def test_while_loop_emits_computed_moves_pointing_at_the_body_line():
+    out, diagnostics = run("""
+#1 = 0
+o101 while [#1 LT 3]
+  G1 X[#1 * 2 + 1] F100
+  #1 = [#1 + 1]
+o101 endwhile
+M2
+G0 X99
+""")
+    assert out == [(3, "  G1 X1 F100"), (3, "  G1 X3 F100"), (3, "  G1 X5 F100"), (6, "M2")]
+    assert not diagnostics.items
+
+
+def test_nested_calls_with_arguments_and_return_values():
+    program = """
+o<double> sub
+  o<double> return [#1 * 2]
+o<double> endsub
+o<quad> sub
+  #<half> = #1
+  o<double> call [#1]
+  o<double> call [#<_value>]
+  G0 X#<_value> Y#1 Z#<half>
+o<quad> endsub [#<_value> + 1]
+#1 = 7
+#<half> = 100
+o<quad> call [3]
+G1 X#<_value> Y#1 Z#<half> A#<_value_returned>
+"""
+    assert texts(program) == ["  G0 X12 Y3 Z3", "G1 X13 Y7 Z100 A1"]
+
+
+def test_value_is_cleared_by_the_next_call():
+    program = """
+o1 sub
+  o1 return [5]
+o1 endsub
+o2 sub
+o2 endsub
+o1 call
+o2 call
+G0 X#<_value> Y#<_value_returned>
+"""
+    assert texts(program) == ["G0 X0 Y0"]
+
+
+def test_call_arguments_keep_the_callers_higher_parameters_and_restore_all():
+    program = """
+#1 = 1
+#2 = 2
+#31 = 0
+o1 sub
+  G0 X#1 Y#2
+  #2 = 20
+  #31 = 31
+o1 endsub
+o1 call [9]
+G0 X#1 Y#2 Z#31
+"""
+    assert texts(program) == ["  G0 X9 Y2", "G0 X1 Y2 Z31"]
+
+
+def test_local_named_parameters_are_not_seen_by_the_subroutine():
+    program = """
+#<depth> = 1
+o1 sub
+  G0 Z#<depth>
+o1 endsub
+o1 call
+"""
+    _, diagnostics = run(program, mode="lenient")
+    assert [(d.line, "not defined" in d.message) for d in diagnostics.errors] == [(3, True)]
+    assert texts("#<_depth> = 1\no1 sub\nG0 Z#<_depth>\no1 endsub\no1 call") == ["G0 Z1"]
+
+
+def test_repeat_and_if_elseif_else_chain():
+    program = """
+#1 = 0
+o1 repeat [4]
+  o2 if [#1 EQ 0]
+    G0 X0
+  o2 elseif [#1 LT 2]
+    G0 X1
+  o2 elseif [#1 EQ 2]
+    G0 X2
+  o2 else
+    G0 X9
+  o2 endif
+  #1 = [#1 + 1]
+o1 endrepeat
+"""
+    assert texts(program) == ["    G0 X0", "    G0 X1", "    G0 X2", "    G0 X9"]
+
+
+def test_do_while_break_and_continue():
+    program = """
+#1 = 0
+o1 do
+  #1 = [#1 + 1]
+  o2 if [#1 EQ 2]
+    o1 continue
+  o2 endif
+  o3 if [#1 EQ 4]
+    o1 break
+  o3 endif
+  G0 X#1
+o1 while [#1 LT 10]
+G0 Y#1
+"""
+    assert texts(program) == ["  G0 X1", "  G0 X3", "G0 Y4"]
+
+
+def test_do_runs_once_and_repeat_zero_not_at_all():
+    assert texts("o1 do\nG0 X1\no1 while [0]\no2 repeat [0]\nG0 X2\no2 endrepeat") == ["G0 X1"]
+
+
+def test_subroutine_file_on_the_search_path(tmp_path):
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "square.ngc").write_text(
+        "(a square of side #1)\no<square> sub\nG1 X#1\nG1 Y#1\no<square> endsub [#1 * 4]\nM2\n")
+    program = "o<Square> call [5]\nG0 Z#<_value>"
+    out, _ = run(program, search_path=[tmp_path / "lib"])
+    assert out == [(3, "G1 X5"), (4, "G1 Y5"), (2, "G0 Z20")]
+    diagnostics = Diagnostics("t.ngc", mode="strict")
+    stage = ControlFlowStage(NGC, search_path=[tmp_path / "lib"])
+    emitted = list(stage.process([SourceLine("o<square> call [1]", 1, "t.ngc")], diagnostics))
+    assert {s.file for s in emitted} == {str(tmp_path / "lib" / "square.ngc")}
+
+
+def test_the_programs_own_directory_is_searched_first(tmp_path):
+    (tmp_path / "peck.ngc").write_text("o<peck> sub\nG0 Z1\no<peck> endsub\n")
+    main = tmp_path / "main.ngc"
+    main.write_text("o<peck> call\n")
+    out, _ = run("o<peck> call", file=str(main))
+    assert out == [(2, "G0 Z1")]
+
+
+def test_errors_in_a_subroutine_file_name_that_file(tmp_path):
+    (tmp_path / "bad.ngc").write_text("o<bad> sub\nG0 X[1/0]\no<bad> endsub\n")
+    with pytest.raises(GcodeError, match=r"bad\.ngc:2:7: .*division by zero"):
+        run("o<bad> call", search_path=[tmp_path])
+
+
+def test_unknown_subroutine_is_an_error_with_a_suggestion():
+    with pytest.raises(GcodeSyntaxError, match=r"t\.ngc:3:1: .*unknown subroutine o<probe>.*did you mean 'o<prob>'"):
+        run("o<prob> sub\no<prob> endsub\no<probe> call")
+    out, diagnostics = run("o<nothing> call\nG0 X1", mode="lenient")
+    assert out == [(2, "G0 X1")] and len(diagnostics.errors) == 1
+
+
+def test_file_names_cannot_leave_the_search_path(tmp_path):
+    (tmp_path / "x.ngc").write_text("o<x> sub\no<x> endsub\n")
+    (tmp_path / "sub").mkdir()
+    _, diagnostics = run("o<../x> call", mode="lenient", search_path=[tmp_path / "sub"])
+    assert "unknown subroutine" in diagnostics.errors[0].message
+
+
+@pytest.mark.parametrize("program, line, message", [
+    ("G0 X1\no1 endsub", 2, "without a matching o1 sub"),
+    ("o1 while [1]\no2 endwhile\no1 endwhile", 2, "without a matching o2 while"),
+    ("o1 else\nG0 X1", 1, "without a matching o1 if"),
+    ("o1 if [1]\nG0 X1", 1, "not closed by o1 endif"),
+    ("o1 repeat [2]\no1 endwhile", 2, "without a matching o1 while"),
+    ("o1 if [1]\no1 else\no1 elseif [1]\no1 endif", 3, "after o1 else"),
+    ("o1 break", 1, "without a matching o1 while or do or repeat"),
+    ("o1 return", 1, "not inside a subroutine"),
+    ("o1 sub\no2 sub\no2 endsub\no1 endsub", 2, "cannot be nested"),
+    ("o1 frobnicate", 1, "unknown O-word keyword 'frobnicate'"),
+    ("o1 if", 1, "needs a value"),
+])
+def test_structure_errors_name_the_line(program, line, message):
+    with pytest.raises(GcodeError, match=rf"t\.ngc:{line}:\d+: .*{message}"):
+        run(program)
+    _, diagnostics = run(program, mode="lenient")
+    assert any(d.line == line and message in d.message for d in diagnostics.errors)
+
+
+def test_lenient_mode_ignores_a_stray_end_and_goes_on():
+    out, diagnostics = run("G0 X1\no5 endwhile\nG0 X2", mode="lenient")
+    assert [t for _, t in out] == ["G0 X1", "G0 X2"] and len(diagnostics.errors) == 1
+
+
+def test_recursion_limit_names_the_call_line():
+    program = """
+o<down> sub
+  G0 Z#1
+  o<down> call [#1 + 1]
+o<down> endsub
+o<down> call [1]
+"""
+    with pytest.raises(GcodeLimitError, match=r"t\.ngc:3:3: .*nested deeper than 9 levels"):
+        run(program)
+    out, diagnostics = run(program, mode="lenient")
+    assert [t.strip() for _, t in out] == [f"G0 Z{k}" for k in range(1, 10)]
+    assert diagnostics.errors[0].line == 3
+
+
+def test_bounded_recursion_returns_through_every_level():
+    program = """
+o<fact> sub
+  o1 if [#1 LE 1]
+    o<fact> return [1]
+  o1 endif
+  o<fact> call [#1 - 1]
+  o<fact> return [#1 * #<_value>]
+o<fact> endsub
+o<fact> call [6]
+G0 X#<_value>
+"""
+    assert texts(program) == ["G0 X720"]
+
+
+def test_infinite_loop_hits_the_iteration_limit_quickly():
+    started = time.perf_counter()
+    with pytest.raises(GcodeLimitError, match=r"t\.ngc:2:1: .*more than 1000000 loop iterations"):
+        run("o1 while [1]\no1 endwhile")
+    assert time.perf_counter() - started < 20
+    with pytest.raises(GcodeLimitError, match=r"t\.ngc:3:1: .*more than 10000 loop iterations"):
+        run("o1 while [1]\n#1 = [#1 + 1]\no1 endwhile", max_iterations=10_000)
+    out, diagnostics = run("o1 do\nG0 X1\no1 while [1]\nG0 X2", mode="lenient", max_iterations=5)
+    assert len(out) == 6 and diagnostics.errors[0].line == 3
+
+
+def test_executed_line_limit_bounds_fan_out_without_loops():
+    subs = "\n".join(f"o{k} sub\n" + f"o{k + 1} call\n" * 10 + f"o{k} endsub" for k in range(1, 8))
+    with pytest.raises(GcodeLimitError, match="more than 10000 lines executed"):
+        run(subs + "\no8 sub\nG0 X1\no8 endsub\no1 call", max_lines=10_000)
+
+
+def test_program_end_stops_inside_a_subroutine():
+    assert texts("o1 sub\nG0 X1\nM30\no1 endsub\no1 call\nG0 X2") == ["G0 X1", "M30"]
+
+
+def test_computed_call_label_and_comments_on_o_lines():
+    program = "o102 sub (two)\nG0 X2\no102 endsub\n#101 = 100\no[#101 + 2] call (computed)"
+    assert texts(program) == ["G0 X2"]
+
+
+def test_assignments_on_a_line_see_old_values_inside_loops():
+    program = "#1 = 1\n#2 = 0\no1 repeat [2]\n#1 = [#1 + 1] #2 = #1 G0 X#1 Y#2\no1 endrepeat"
+    assert texts(program) == ["G0 X1 Y0", "G0 X2 Y1"]
+
+
+def test_store_is_shared_with_the_caller():
+    store = ParameterStore()
+    stage = ControlFlowStage(NGC, store)
+    list(stage.process([SourceLine("#<_done> = 1", 1, "t.ngc")], Diagnostics()))
+    assert store.get("_done") == 1.0 and store.call_depth == 0
+
+
+FANUC = load_flavor("fanuc")
+
+
+def test_fanuc_m98_with_repeats_and_m99():
+    program = """
+%
+O0001 (MAIN)
+#1 = 0;
+M98 P1000 L3;
+G0 X#1;
+M30;
+O1000 (SUB)
+#1 = [#1 + 1];
+G1 X#1;
+M98 P2000;
+M99;
+O2000
+G1 Y#1;
+M99;
+%
+"""
+    out, diagnostics = run(program, flavor=FANUC)
+    assert [t for _, t in out] == ["%", "G1 X1;", "G1 Y1;", "G1 X2;", "G1 Y2;", "G1 X3;", "G1 Y3;", "G0 X3;", "M30;"]
+    assert not diagnostics.items
+
+
+def test_fanuc_m98_l0_and_unknown_program():
+    assert texts("M98 P1 L0\nG0 X1\nM30\nO1\nG0 X9\nM99", flavor=FANUC) == ["G0 X1", "M30"]
+    with pytest.raises(GcodeError, match="unknown program o77"):
+        run("M98 P77", flavor=FANUC)
+
+
+def test_m99_in_the_main_program_ends_it_with_a_warning():
+    out, diagnostics = run("G0 X1\nM99\nG0 X2", flavor=FANUC)
+    assert [t for _, t in out] == ["G0 X1"] and diagnostics.items[0].severity == "warning"
+
+
+def test_pipeline_runs_o_word_programs():
+    import gcodekit
+
+    program = "G21 G90\n#1 = 0\no1 while [#1 LT 3]\nG1 X[#1 + 1] F600\n#1 = [#1 + 1]\no1 endwhile\nM2\n"
+    op = gcodekit.gcode_to_operation(program, "linuxcnc", plan=False, mode="strict")
+    motions = op.motions()
+    assert motions["x"].tolist() == [1.0, 2.0, 3.0]
+    assert motions["line"].tolist() == [4, 4, 4]
+
+
+# -- never hang, never crash -------------------------------------------------
+
+_FLOW = ["sub", "endsub", "call", "return", "if", "elseif", "else", "endif", "while", "endwhile",
+         "do", "repeat", "endrepeat", "break", "continue", ""]
+_VALUES = ["", " [1]", " [0]", " [#1 LT 3]", " [#1 + 1]", " [#<_value>]", " [1/0]", " [2]", " [#1]"]
+_LINES = st.one_of(
+    st.builds(lambda n, k, v: f"o{n} {k}{v}", st.sampled_from([1, 2, 3]), st.sampled_from(_FLOW),
+              st.sampled_from(_VALUES)),
+    st.sampled_from(["#1 = [#1 + 1]", "G0 X#1", "G1 X[#1 * 2] Y#<_value>", "M2", "M98 P1 L2", "M99",
+                     "#<_x> = #1", "G0 Y#<_x>", "O1", "o<rec> call", "(comment)"]),
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(_LINES, max_size=25))
+def test_random_flow_never_hangs_and_raises_only_gcodekit_errors(program):
+    lines = [SourceLine(t, n, "r.ngc") for n, t in enumerate(program, 1)]
+    stage = ControlFlowStage(NGC, max_iterations=200, max_lines=5_000)
+    try:
+        out = list(stage.process(lines, Diagnostics("r.ngc", mode="strict")))
+    except GcodeError:
+        return
+    assert len(out) <= 5_000
+    lenient = Diagnostics("r.ngc", mode="lenient")
+    list(ControlFlowStage(NGC, max_iterations=200, max_lines=5_000).process(lines, lenient))
