@@ -314,3 +314,9 @@ def test_incremental_canned_cycle_repeats():
     assert holes["x"].tolist() == [10.0, 20.0, 30.0]
     assert holes["z"].tolist() == [-2.0, -2.0, -2.0]
     assert m["z"].iloc[-1] == 5.0  # G98 (default): back to the start height
+
+
+def test_inverse_time_feed_is_not_scaled_by_inches():
+    _, df = run("G20 G93 G1 X1 F2\n")  # 1 inch in 1/2 minute, whatever the units
+    assert df["time"].iloc[-1] == pytest.approx(30.0)
+    assert df["feed"].iloc[-1] == pytest.approx(2 * 25.4)  # mm/min actually travelled

@@ -173,7 +173,9 @@ class Machine:
                 s.program_shift[:] = 0.0
         start_pos = np.vstack([s.position[None, :], position[:-1]])
 
-        feed_words = _dense(t.params["F"], rows) * s.units if "F" in t.params else np.full(n, np.nan)
+        feed_words = _dense(t.params["F"], rows) if "F" in t.params else np.full(n, np.nan)
+        if s.feed_mode != "inverse_time":  # G93's F is 1/minutes, not a length
+            feed_words *= s.units
         feed_words[kind == Kind.COMMENT] = np.nan
         if not self.feed_in_any_block:
             feed_words[kind == Kind.M] = np.nan
@@ -198,7 +200,8 @@ class Machine:
         for ax, letter in enumerate(AXES.lower()):
             out[letter][rows] = position[:, ax]
         out["de"][rows] = de
-        out["feed"][rows] = feed
+        # G93 gives each move a time (1/F minutes); like rs274, report the speed that makes
+        out["feed"][rows] = feed * np.where(distance > 0, distance, rotary) if s.feed_mode == "inverse_time" else feed
         out["distance"][rows] = distance
         out["time"][rows] = time
         out["motion"][rows] = motion

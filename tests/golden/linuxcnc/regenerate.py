@@ -49,7 +49,6 @@ ANGLED = re.compile(r"<[^>]*>")
 LETTER_RUN = re.compile(r"[A-Z]{2,}")  # functions, operators and O-word keywords
 CODE = re.compile(r"(?<![A-Z])([GM])(\d+(?:\.\d+)?)")
 COMPUTED_CODE = re.compile(r"(?<![A-Z])[GM][\[#]")
-OWORD = re.compile(r"(?<![A-Z])O[\d<\[#]")
 SYSTEM_NUMBERED = re.compile(r"#5\d{3}(?!\d)")
 
 #: Predefined (read-only) named parameters of LinuxCNC 2.9.
@@ -85,7 +84,6 @@ ALLOWED_G = frozenset("""
 98 99
 """.split())
 EXCLUDED_M = {
-    **dict.fromkeys(("98", "99"), "subprogram"),
     **dict.fromkeys(tuple(str(n) for n in range(62, 69)), "digital/analog I/O"),
 }
 ALLOWED_M = frozenset("0 1 2 3 4 5 6 7 8 9 19 30 48 49 50 51 52 53 60 61 70 71 72 73".split())
@@ -118,8 +116,6 @@ def scan_text(text: str) -> tuple[list[str], list[str]]:
         if key in SYSTEM_NAMED or key.startswith(("_ini[", "_hal[")):
             reasons[f"system parameter #<{key}>"] = None
     body = ANGLED.sub("<>", body)
-    if OWORD.search(body):
-        reasons["O-word"] = None
     body = LETTER_RUN.sub(" ", body)
     if SYSTEM_NUMBERED.search(body):
         reasons["system parameter #5xxx"] = None
