@@ -29,8 +29,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import ConfigError
-from ...parse.table import MOTION_RAPID, NAME_ID
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
+from ...parse.table import MOTION_RAPID
+from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before
 from .scans import backward_min, forward_min
 
 if TYPE_CHECKING:
@@ -293,11 +293,8 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
     acceleration = limit_by_axis_maximum(config.acceleration, unit_vec)
     rapid_rate = limit_by_axis_maximum(config.max_rate_v, unit_vec)
     rapid = np.asarray(w["motion"])[moves.waypoint] == MOTION_RAPID
+    # G93 needs nothing here: the emulator already turned "1/F minutes" into a speed
     programmed = moves.speed_v.copy()
-    inverse_time = _inverse_time(op, moves)
-    if inverse_time.any():
-        # G93: F blocks per minute; the whole (arc) block takes 1/F min
-        programmed[inverse_time] = moves.speed_v[inverse_time] * np.asarray(w["distance"])[moves.waypoint[inverse_time]]
     # plan_compute_profile_nominal_speed
     nominal = np.where(rapid, rapid_rate, np.minimum(programmed, rapid_rate))
     nominal = np.maximum(np.nan_to_num(nominal, nan=MINIMUM_FEED_RATE), MINIMUM_FEED_RATE)
@@ -323,15 +320,6 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
     rest_after = np.r_[rest_before[1:], True]
     entry_v2, exit_v2 = lookahead(max_entry_v2, 2.0 * acceleration * move_d, rest_after)
     return moves, trapezoid(move_d, acceleration, entry_v2, nominal**2, exit_v2)
-
-
-def _inverse_time(op: "Operation", moves: PlannerMoves) -> np.ndarray:
-    """Per move: is G93 (inverse time feed) in force?  (G93 is its own row before the move's.)"""
-    rows = command_rows(op, names=("feed_inverse_time", "feed_per_minute", "feed_per_rev"))
-    if rows.size == 0:
-        return np.zeros(len(moves), bool)
-    is_g93 = op.table.name[rows] == NAME_ID["feed_inverse_time"]
-    return in_force(moves, rows, is_g93, 0.0) > 0
 
 
 def _spindle_syncs(op: "Operation", moves: PlannerMoves, config: GrblConfig) -> np.ndarray:
