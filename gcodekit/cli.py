@@ -1,4 +1,4 @@
-"""Command line: ``gcodekit info`` and ``gcodekit export``.
+"""Command line: ``gcodekit info``, ``gcodekit export`` and ``gcodekit translate``.
 
 Examples
 --------
@@ -39,6 +39,16 @@ def _parser() -> argparse.ArgumentParser:
     export.add_argument("--to", choices=EXPORT_FORMATS, default="csv", help="output format (default: csv)")
     export.add_argument("-o", "--output", metavar="OUT", help="output file (default: standard output)")
     export.add_argument("-f", "--force", action="store_true", help="overwrite OUT if it exists")
+
+    translate = sub.add_parser("translate", help="simplify a mill program stage by stage (GER's transpiler)")
+    translate.add_argument("file", metavar="FILE")
+    _common(translate)
+    translate.add_argument("--stage", type=int, default=6, choices=range(7), metavar="K",
+                           help="0 expanded, 1 units, 2 offsets, 3 polar, 4 absolute, 5 cutter comp, 6 cycles "
+                                "(default: 6, plain G0-G3)")
+    translate.add_argument("--to", metavar="FLAVOR", help="write in this dialect (default: rs274ngc)")
+    translate.add_argument("-o", "--output", metavar="OUT", help="output file (default: standard output)")
+    translate.add_argument("-f", "--force", action="store_true", help="overwrite OUT if it exists")
     return p
 
 
@@ -57,6 +67,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "info":
             return _info(args)
+        if args.command == "translate":
+            return _translate(args)
         return _export(args)
     except (GcodeError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
         print(f"gcodekit: error: {exc}", file=sys.stderr)
@@ -178,6 +190,28 @@ def _export(args: argparse.Namespace) -> int:
     frame.to_csv(target, index=False, float_format="%.6f", lineterminator="\n")
     errors = [d for d in op.diagnostics if d.severity == "error"]
     for d in errors[:10]:
+        print(str(d), file=sys.stderr)
+    return 0
+
+
+def _translate(args: argparse.Namespace) -> int:
+    from .transpile import Transpiler
+
+    if args.output and os.path.exists(args.output) and not args.force:
+        print(f"gcodekit: error: {args.output} exists; use --force to overwrite it", file=sys.stderr)
+        return 2
+    op = _load(args.file, args)
+    text = Transpiler(op).stage(args.stage)
+    if args.to and args.to != "rs274ngc":
+        from .emulate.exporters import GcodeExporter
+        from .pipeline import parse_program
+
+        text = GcodeExporter(args.to).to_gcode(parse_program(text, flavor="rs274ngc"))
+    if args.output:
+        Path(args.output).write_text(text)
+    else:
+        sys.stdout.write(text)
+    for d in [d for d in op.diagnostics if d.severity == "error"][:10]:
         print(str(d), file=sys.stderr)
     return 0
 

@@ -74,3 +74,12 @@ def test_progress_bar_on_a_terminal(tmp_path, monkeypatch):
     monkeypatch.setattr("sys.stdout", io.StringIO())
     assert cli.main(["info", str(big)]) == 0
     assert "B/s" in stderr.getvalue() or "%|" in stderr.getvalue()
+
+
+def test_translate_writes_plain_gcode(tmp_path, capsys):
+    target = tmp_path / "plain.ngc"
+    status, _, _ = run(["translate", MILL, "--stage", "6", "-o", target], capsys)
+    assert status == 0
+    body = [line for line in target.read_text().splitlines() if not line.startswith("(")]
+    assert body and all(line.split()[1] in ("G0", "G1", "G2", "G3", "G4", "M3", "M5", "M6", "M8", "M9")
+                        for line in body)
