@@ -16,6 +16,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .parse.table import NAME_ID as NAME_ID_LOOKUP
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -214,4 +216,67 @@ def velocity_profile(op: "Operation") -> "pd.DataFrame":
     return pd.DataFrame({
         "time": times.ravel(), "distance": dist.ravel(), "planned": speed.ravel(), "commanded": commanded,
         "line": np.repeat(op.table.line[moves.row], 4),
+    })
+
+
+_PART_NAME = re.compile(r"Part name:\s*(.+)")
+_SLICE = re.compile(r"New Slice of body .*?No\.:\s*(\d+)")
+_FRACTION = re.compile(r"Fraction\s+(\d+)")
+
+
+def part_name(op: "Operation") -> str:
+    """The DED part name from the ``(Part name: ...)`` header, else the file's stem."""
+    t = op.table
+    for k in range(min(t.comment_rows.size, 50)):
+        m = _PART_NAME.search(t.comment(k))
+        if m:
+            return m.group(1).strip()
+    from pathlib import Path
+
+    return Path(op.file).stem
+
+
+def tool_vectors(a_deg: np.ndarray, b_deg: np.ndarray) -> np.ndarray:
+    """Unit tool directions (u, v, w) = (sin B, -sin A cos B, cos A cos B) of a 5-axis head.
+
+    A and B in degrees; A = B = 0 points along +Z.
+    """
+    a, b = np.radians(a_deg), np.radians(b_deg)
+    return np.column_stack([np.sin(b), -np.sin(a) * np.cos(b), np.cos(a) * np.cos(b)])
+
+
+def ded_moves(op: "Operation") -> "pd.DataFrame":
+    """One row per G0/G1 of a DED program, as the Beckhoff DED tooling reads it.
+
+    Columns ``line_no, x, y, z, a, b, move_type ("rapid"/"cut"), weld_state
+    ("on"/"off"), slice_no, fraction_no, u, v, w``.  Slice and fraction come
+    from the ``(New Slice of body ... No.: n)`` and ``(... Fraction n ...)``
+    comments; the weld state from M61 (on, also inline) and M62 (off).  A move
+    missing X, Y or Z is left out (and reported when the program is read).
+    """
+    import pandas as pd
+
+    t, w = op.table, op.waypoints
+    rows = waypoint_rows(op)
+    names = t.name[rows]
+    straight = np.isin(names, [NAME_ID_LOOKUP["rapid"], NAME_ID_LOOKUP["linear"]])
+    full = np.ones(rows.size, bool)
+    for letter in "XYZ":
+        full &= ~np.isnan(t.param(letter)[rows])
+    keep = np.flatnonzero(straight & full)
+    slice_marks, slices = _row_labels(op, _SLICE.pattern)
+    fraction_marks, fractions = _row_labels(op, _FRACTION.pattern)
+    slice_no = np.array([0] + [int(s) for s in slices])[slice_marks[rows[keep]] + 1]
+    fraction_no = np.array([0] + [int(f) for f in fractions])[fraction_marks[rows[keep]] + 1]
+    a = np.nan_to_num(t.param("A")[rows[keep]])
+    b = np.nan_to_num(t.param("B")[rows[keep]])
+    uvw = tool_vectors(a, b)
+    return pd.DataFrame({
+        "line_no": t.line[rows[keep]],
+        "x": t.param("X")[rows[keep]], "y": t.param("Y")[rows[keep]], "z": t.param("Z")[rows[keep]],
+        "a": a, "b": b,
+        "move_type": np.where(names[keep] == NAME_ID_LOOKUP["rapid"], "rapid", "cut"),
+        "weld_state": np.where(np.asarray(w["laser"])[keep] == 1, "on", "off"),
+        "slice_no": slice_no, "fraction_no": fraction_no,
+        "u": uvw[:, 0], "v": uvw[:, 1], "w": uvw[:, 2],
     })

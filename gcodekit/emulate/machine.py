@@ -40,6 +40,7 @@ SMALL_COLUMNS = {
     "units": (np.uint8, "program units in force: 0 mm, 1 inch"),
     "tool": (np.int32, "tool in the spindle or active extruder"),
     "coolant": (np.uint8, "bit 1 mist, bit 2 flood"),
+    "laser": (np.uint8, "1 while the laser/weld heat source is on (DED: M61 on, M62 off)"),
     "work_offset": (np.uint8, "1..9 for G54..G59.3"),
 }
 _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTRUDE, Kind.MOVE_MILL,
@@ -135,6 +136,7 @@ class Machine:
         out["units"][rows] = 1 if s.units != 1.0 else 0
         out["tool"][rows] = s.tool
         out["coolant"][rows] = s.coolant
+        out["laser"][rows] = s.laser
         out["work_offset"][rows] = s.work_offset
 
     # -- runs of plain commands ---------------------------------------------------

@@ -33,7 +33,7 @@ SPECIAL_NAMES = frozenset(
     coolant_mist coolant_flood coolant_off program_end machine_coordinates
     firmware_retract firmware_unretract set_kinematic_position
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
-    coordinate_data local_offset retract_initial retract_r""".split()
+    coordinate_data local_offset retract_initial retract_r laser_on laser_off""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)}
 
 _MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
@@ -119,6 +119,8 @@ class ModalHandler:
         elif name in ("spindle_cw", "spindle_ccw", "spindle_off"):
             s.spindle = {"spindle_cw": 1, "spindle_ccw": -1, "spindle_off": 0}[name]
             s.speed = params.get("S", s.speed)
+        elif name in ("laser_on", "laser_off"):
+            s.laser = int(name == "laser_on")
         elif name in ("coolant_mist", "coolant_flood", "coolant_off"):
             s.coolant = {"coolant_mist": s.coolant | 1, "coolant_flood": s.coolant | 2, "coolant_off": 0}[name]
         elif name == "program_end":
@@ -347,4 +349,5 @@ class ModalHandler:
         out["units"][row] = 1 if s.units != 1.0 else 0
         out["tool"][row] = s.tool
         out["coolant"][row] = s.coolant
+        out["laser"][row] = s.laser
         out["work_offset"][row] = s.work_offset

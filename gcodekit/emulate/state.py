@@ -54,6 +54,7 @@ class MachineState:
     speed: float = 0.0  # S for the spindle, rpm
     spindle: int = 0  # 1 CW, -1 CCW, 0 stopped
     coolant: int = 0  # bit 1 mist, bit 2 flood
+    laser: int = 0  # heat source (DED laser or weld arc) on
     retracted: bool = False  # firmware retraction (G10) in effect
     cycle: CycleState = field(default_factory=CycleState)  # canned-cycle words in force
     ended: bool = False  # M2/M30 reached: later blocks are not run

@@ -317,6 +317,14 @@ class GcodeParser:
         for i in np.flatnonzero(orphan)[:100].tolist():
             self.diagnostics.warn(int(t["line"][i]), 1, "words without a command are ignored by this firmware")
         kind[orphan] = Kind.CONFIG
+        if self.flavor.required_axes:
+            straight = np.isin(name, [NAME_ID["rapid"], NAME_ID["linear"]])
+            missing = np.zeros(n, bool)
+            for letter in self.flavor.required_axes:
+                missing |= ~has(letter)
+            for i in np.flatnonzero(straight & missing)[:100].tolist():
+                absent = ",".join(c for c in self.flavor.required_axes if c not in params or np.isnan(params[c][i]))
+                self.diagnostics.warn(int(t["line"][i]), 1, f"motion without {absent} (this dialect writes every axis)")
         t["name"], t["motion"], t["kind"] = name, motion, kind
 
     def _report_unknown(self, t: dict, name: np.ndarray) -> None:

@@ -132,6 +132,9 @@ class Flavor:
     code_assignments : bool
         A code may carry a value after ``=`` (Beckhoff ``M60=1``); the value
         becomes the command's ``value`` parameter.
+    required_axes : str
+        Letters every G0/G1 must carry; a motion missing one is reported
+        (the Beckhoff DED dialect writes X, Y and Z on every move).
     polar_words : bool
         ``@`` (distance) and ``^`` (angle, degrees) words give X and Y in polar
         form (LinuxCNC).
@@ -182,6 +185,7 @@ class Flavor:
     code_assignments: bool = False
     directive_prefix: str = ""
     polar_words: bool = False
+    required_axes: str = ""
     words: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     codes: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     units: str = "mm"
