@@ -212,16 +212,20 @@ def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineCon
 
 def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None) -> Iterator[tuple[Blocks, int]]:
     """Blocks of the program chunk by chunk, preprocessed when it needs it."""
-    if flavor.parameters:
+    if flavor.parameters or flavor.wizards:
         from .preprocess import ControlFlowStage, SourceLine, needs_parameters, run_stages
+        from .preprocess.wizards import WizardStage, needs_wizards
 
         text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
-        if needs_parameters(text) or _O_WORD_LINE.search(text):
+        stages = [ControlFlowStage(flavor)] if flavor.parameters and (
+            needs_parameters(text) or _O_WORD_LINE.search(text)) else []
+        stages += [WizardStage(flavor)] if flavor.wizards and needs_wizards(text) else []
+        if stages:
             lines = text.split("\n")
             if lines and lines[-1] == "":
                 lines.pop()
             source = (SourceLine(t.rstrip("\r"), k + 1, program.name) for k, t in enumerate(lines))
-            out = run_stages(source, [ControlFlowStage(flavor)], diagnostics)
+            out = run_stages(source, stages, diagnostics)
             yield read_source_lines(out, flavor, diagnostics), len(lines)
             return
         chunks: Iterator[bytes] = iter_lines(text)
