@@ -119,6 +119,24 @@ def in_force(moves: PlannerMoves, rows: np.ndarray, values: np.ndarray, initial:
     return np.where(k >= 0, np.asarray(values, float)[np.maximum(k, 0)], initial)
 
 
+def m204_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray,
+                  targets: dict[str, tuple[str, float]]) -> dict[str, np.ndarray]:
+    """M204 per move: S sets every acceleration, a named word (P, T) overrides it.
+
+    ``targets`` maps a word letter to (result name, value before any M204).
+    Marlin 2 (M204.cpp) and RepRapFirmware 3 read it this way.
+    """
+    t = op.table
+    s_word = t.param("S")[rows]
+    out = {}
+    for letter, (name, default) in targets.items():
+        word = t.param(letter)[rows]
+        value = np.where(np.isnan(word), s_word, word)
+        given = ~np.isnan(value)
+        out[name] = in_force(moves, rows[given], value[given], default)
+    return out
+
+
 def happens_before(moves: PlannerMoves, rows: np.ndarray) -> np.ndarray:
     """Per move: does one of ``rows`` come between the previous move and this one?"""
     if rows.size == 0 or len(moves) == 0:

@@ -38,7 +38,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import ConfigError
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
+from .base import (PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force,
+                   m204_in_force, speed_factor)
 from .grbl import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
 
 
@@ -235,14 +236,8 @@ def _program_limits(op: "Operation", moves: PlannerMoves, config: MarlinConfig) 
         "min_feedrate": settings_in_force(op, moves, m205, "S", config.min_feedrate),
         "min_travel_feedrate": settings_in_force(op, moves, m205, "T", config.min_travel_feedrate),
     }
-    # M204.cpp: S sets print and travel acceleration, then P and T override it
-    t = op.table
-    s_word = t.param("S")[m204]
-    for letter, name in (("P", "acceleration"), ("T", "travel_acceleration")):
-        word = t.param(letter)[m204]
-        value = np.where(np.isnan(word), s_word, word)
-        given = ~np.isnan(value)
-        limits[name] = in_force(moves, m204[given], value[given], getattr(config, name))
+    limits.update(m204_in_force(op, moves, m204, {"P": ("acceleration", config.acceleration),
+                                                  "T": ("travel_acceleration", config.travel_acceleration)}))
     return limits
 
 

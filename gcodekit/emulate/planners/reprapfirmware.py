@@ -33,7 +33,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import ConfigError
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
+from .base import (PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, m204_in_force,
+                   speed_factor)
 from .grbl import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
 
 from .marlin import settings_in_force
@@ -178,7 +179,6 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray, sp
 
 def _program_limits(op: "Operation", moves: PlannerMoves, config: RrfConfig) -> dict:
     """Per move, the limits in force, in mm/s and mm/s^2: the config's, then the program's."""
-    t = op.table
     m201 = command_rows(op, names=("set_max_accel",))
     m203 = command_rows(op, names=("set_max_feed",))
     m204 = command_rows(op, names=("set_accel",))
@@ -200,12 +200,9 @@ def _program_limits(op: "Operation", moves: PlannerMoves, config: RrfConfig) -> 
         "minimum_movement_speed": settings_in_force(op, moves, m203, "I", config.minimum_movement_speed / 60.0,
                                                     1.0 / 60.0),
     }
-    s_word = t.param("S")[m204]
-    for letter, name in (("P", "max_printing_acceleration"), ("T", "max_travel_acceleration")):
-        word = t.param(letter)[m204]
-        value = np.where(np.isnan(word), s_word, word)
-        given = ~np.isnan(value)
-        limits[name] = in_force(moves, m204[given], value[given], getattr(config, name))
+    limits.update(m204_in_force(op, moves, m204, {
+        "P": ("max_printing_acceleration", config.max_printing_acceleration),
+        "T": ("max_travel_acceleration", config.max_travel_acceleration)}))
     return limits
 
 
