@@ -17,6 +17,7 @@ from .emulate.operation import (
     SubtractiveOperation,
     SubtractiveProcessData,
 )
+from .analysis import export_event_series_from_gcode, gcode_dataframe_to_event_series
 from .emulate.exporters import GcodeExporter
 from .emulate.presets import MachineConfig, list_machines, load_machine
 from .errors import (
@@ -38,6 +39,6 @@ __all__ = [
     "AdditiveOperation", "AdditiveProcessData", "ConfigError", "GcodeExporter", "Diagnostic", "GcodeError",
     "GcodeExpressionError", "GcodeLimitError", "GcodeMachineError", "GcodeParser", "GcodeSyntaxError",
     "MachineConfig", "Operation", "ProcessData", "SubtractiveOperation", "SubtractiveProcessData",
-    "detect_flavor", "emulate_operation", "gcode_file_to_dataframe", "gcode_to_operation", "list_flavors",
+    "detect_flavor", "emulate_operation", "export_event_series_from_gcode", "gcode_dataframe_to_event_series", "gcode_file_to_dataframe", "gcode_to_operation", "list_flavors",
     "list_machines", "load_flavor", "load_machine", "parse_program",
 ]

@@ -280,3 +280,69 @@ def ded_moves(op: "Operation") -> "pd.DataFrame":
         "slice_no": slice_no, "fraction_no": fraction_no,
         "u": uvw[:, 0], "v": uvw[:, 1], "w": uvw[:, 2],
     })
+
+
+def gcode_dataframe_to_event_series(df: "pd.DataFrame", source: str = "material") -> "pd.DataFrame":
+    """An Abaqus AM event series from a waypoint DataFrame (``Operation.to_dataframe``).
+
+    Parameters
+    ----------
+    df : DataFrame
+        Needs ``x, y, z, de, distance, time, elapsed_time, motion`` (and
+        ``laser`` for ``source="heat"``).
+    source : {"material", "heat"}, default: "material"
+        ``material``: 1 while material is deposited (filament pushed on a
+        move); ``heat``: 1 while the laser/weld heat source is on during a move
+        (DED, M61/M62).
+
+    Returns
+    -------
+    DataFrame with ``time, x, y, z, value``: at each time the source is at
+    that point with that value until the next event, moving in a straight
+    line between events (how Abaqus reads an event series).  The last event
+    switches the source off.
+
+    Examples
+    --------
+    >>> import gcodekit
+    >>> df = gcodekit.gcode_file_to_dataframe("M83\\nG1 X10 E1 F600\\nG1 X20\\n", "marlin", plan=False)
+    >>> gcode_dataframe_to_event_series(df).values.tolist()
+    [[0.0, 0.0, 0.0, 0.0, 1.0], [1.0, 10.0, 0.0, 0.0, 0.0], [2.0, 20.0, 0.0, 0.0, 0.0]]
+    """
+    import pandas as pd
+
+    from .errors import check_choice
+
+    check_choice("source", source, ("material", "heat"))
+    motion = np.asarray(df["motion"].cat.codes if hasattr(df["motion"], "cat") else df["motion"])
+    moved = np.flatnonzero(motion > 0)
+    if moved.size == 0:
+        return pd.DataFrame(columns=["time", "x", "y", "z", "value"])
+    xyz = df[["x", "y", "z"]].to_numpy(float)
+    end_t = df["elapsed_time"].to_numpy(float)[moved]
+    start_t = end_t - np.nan_to_num(df["time"].to_numpy(float)[moved])
+    start_xyz = np.vstack([np.zeros((1, 3)), xyz[:-1]])[moved]
+    if source == "material":
+        value = (df["de"].to_numpy(float)[moved] > 0) & (df["distance"].to_numpy(float)[moved] > 0)
+    else:
+        value = (df["laser"].to_numpy()[moved] == 1) & (motion[moved] >= 2)
+    events = pd.DataFrame({"time": np.r_[start_t, end_t[-1]],
+                           "x": np.r_[start_xyz[:, 0], xyz[moved[-1], 0]],
+                           "y": np.r_[start_xyz[:, 1], xyz[moved[-1], 1]],
+                           "z": np.r_[start_xyz[:, 2], xyz[moved[-1], 2]],
+                           "value": np.r_[value.astype(float), 0.0]})
+    # a run of travel moves is one "off" event: the source is off wherever it is
+    off = events["value"].to_numpy() == 0
+    repeat = off & np.r_[False, off[:-1]]
+    repeat[-1] = False
+    return events[~repeat].reset_index(drop=True)
+
+
+def export_event_series_from_gcode(path, output_path, *, source: str = "material", machine: str | None = None,
+                                   **options) -> "pd.DataFrame":
+    """Write the Abaqus event series of a program (``time, x, y, z, value`` lines, no header)."""
+    from .pipeline import gcode_to_operation
+
+    events = gcode_dataframe_to_event_series(gcode_to_operation(path, machine, **options).to_dataframe(), source)
+    events.to_csv(output_path, header=False, index=False, float_format="%.6f")
+    return events
