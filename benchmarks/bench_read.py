@@ -1,7 +1,7 @@
 """Benchmark: read, parse and emulate a large program, against gcodeparser's tokeniser.
 
 The acceptance benchmark of the foundation issue: ``gcodekit.gcode_to_operation``
-turns ``plate150_marlin2.gcode.gz`` (3.1 M lines) into the columnar operation in
+(with ``plan=False``: the motion planner is measured by ``bench_plan.py``) turns ``plate150_marlin2.gcode.gz`` (3.1 M lines) into the columnar operation in
 at most 0.4x the wall time that gcodeparser 0.3.0 needs only to tokenise the
 same file, with a peak memory of at most 300 bytes per input line.
 
@@ -93,7 +93,7 @@ def measure(tool: str, path: Path) -> dict:
     baseline = max_rss()
     start = time.perf_counter()
     if tool == "gcodekit":
-        items = len(gcodekit.gcode_to_operation(path))
+        items = len(gcodekit.gcode_to_operation(path, plan=False))
     else:
         with open_program(path) as f:
             items = sum(1 for _ in parse_gcode_lines(f))
