@@ -24,12 +24,20 @@ if TYPE_CHECKING:
     from .emulate.operation import Operation
 
 
+def depositing(w: dict) -> np.ndarray:
+    """Waypoints that lay material: filament pushed on a move (FFF, LFAM), or a
+    feed move with the heat source on (DED, where the wire or powder has no E)."""
+    moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
+    welding = (np.asarray(w["laser"]) == 1) & (np.asarray(w["motion"]) >= 2) if "laser" in w else False
+    return moving & ((np.asarray(w["de"]) > 0) | welding)
+
+
 def operation_statistics(op: "Operation") -> dict[str, Any]:
     """Counts, distances and time of an emulated operation (see ``get_statistics``)."""
     w = op.waypoints
     motion, distance, de = w["motion"], w["distance"], w["de"]
     moving = motion > 0
-    extruding = moving & (de > 0) & (distance > 0)
+    extruding = depositing(w)
     stats: dict[str, Any] = {
         "lines": op.n_lines,
         "commands": len(op.table),
@@ -74,7 +82,7 @@ def count_layers(op: "Operation") -> int:
         if count:
             return count
     w = op.waypoints
-    extruding = (w["motion"] > 0) & (w["de"] > 0) & (w["distance"] > 0)
+    extruding = depositing(w)
     return int(np.unique(np.round(w["z"][extruding], 4)).size)
 
 
@@ -128,7 +136,7 @@ def layers(op: "Operation") -> np.ndarray:
     if (marks >= 0).any():
         return marks[waypoint_rows(op)]
     w = op.waypoints
-    extruding = (w["motion"] > 0) & (w["de"] > 0) & (w["distance"] > 0)
+    extruding = depositing(w)
     z = np.round(np.asarray(w["z"]), 4)
     new_layer = extruding & (z != np.r_[np.nan, z[:-1]])
     starts = np.flatnonzero(new_layer)
