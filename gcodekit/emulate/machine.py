@@ -61,13 +61,14 @@ class Machine:
 
     def __init__(self, config: MachineConfig, diagnostics: Diagnostics | None = None, *,
                  rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = "",
-                 feed_in_any_block: bool = False):
+                 rs274_blocks: bool = False):
         self.config = config
         self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
         self.rapid_is_feed = config.rapid_is_feed if config.rapid_is_feed is not None else rapid_is_feed
-        # RS274NGC: an F word sets the feed whatever else the block does; printer
-        # firmware reads F only on moves (an M-code's F means something else).
-        self.feed_in_any_block = feed_in_any_block
+        # RS274NGC block rules: an F word sets the feed whatever else the block
+        # does, and a word for an axis the machine lacks is an error.  Printer
+        # firmware reads F only on moves and U/V/W as flags (Prusa's G28 W).
+        self.rs274_blocks = rs274_blocks
         self.state = MachineState()
         self.state.units = 25.4 if initial_units == "inch" else 1.0
         self.state.e_relative = initial_extrusion == "relative"
@@ -95,6 +96,8 @@ class Machine:
         special = np.isin(table.name, self.modal.special_ids) | (table.letter == ord("T"))
         special |= table.kind == Kind.MACHINE_COORDINATES
         special |= (table.motion == MOTION_CYCLE) & np.isin(table.kind, _MOVING)
+        if self.rs274_blocks:
+            self._check_axis_words(table)
         for letter in "@^":  # polar words depend on where the tool is: one block at a time
             if letter in table.params:
                 special |= ~np.isnan(table.param(letter)) & np.isin(table.kind, _MOVING)
@@ -116,6 +119,22 @@ class Machine:
             self._hold(cursor, n, out)
             self._once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
         return _constants_as_views(_with_extra_waypoints(out, extra, n))
+
+    def _check_axis_words(self, table: CommandTable) -> None:
+        """U/V/W words name axes this machine lacks: LinuxCNC refuses the block
+        (``read_one_item`` in interp_read.cc has no reader for an axis letter
+        outside the axis mask; rs274 standalone has X Y Z A B C)."""
+        for letter in "UVW":
+            col = table.params.get(letter)
+            if col is None or letter in self._warned:
+                continue
+            given = ~np.isnan(col if isinstance(col, np.ndarray) else col.dense())
+            rows = np.flatnonzero(given & (table.kind != Kind.COMMENT))
+            if rows.size:
+                self._warned.add(letter)
+                self.diagnostics.report(int(table.line[rows[0]]), 1, f"Bad character '{letter.lower()}' used: "
+                                        f"this machine has no {letter} axis (it has {' '.join(AXES)})",
+                                        kind="machine")
 
     def _hold(self, start: int, stop: int, out: dict) -> None:
         """Rows after the program end: nothing moves."""
@@ -179,7 +198,7 @@ class Machine:
         if s.feed_mode != "inverse_time":  # G93's F is 1/minutes, not a length
             feed_words *= s.units
         feed_words[kind == Kind.COMMENT] = np.nan
-        if not self.feed_in_any_block:
+        if not self.rs274_blocks:
             feed_words[kind == Kind.M] = np.nan
         if s.feed_mode == "inverse_time":
             feed = feed_words  # 1/min, for this block only

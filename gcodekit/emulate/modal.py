@@ -78,7 +78,7 @@ class ModalHandler:
         if self.machine.config.block_delete and row in set(t.deleted.tolist()):
             self._write(out, row, before, MOTION_NONE)
             return []
-        if "F" in params and (chr(int(t.letter[row])) != "M" or self.machine.feed_in_any_block):
+        if "F" in params and (chr(int(t.letter[row])) != "M" or self.machine.rs274_blocks):
             s.feed = params["F"] * s.units
         moves = int(t.kind[row]) in _MOVING_KINDS
         if moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):

@@ -335,7 +335,13 @@ class GcodeParser:
             if code in self._unknown_reported:
                 continue
             self._unknown_reported.add(code)
-            self.diagnostics.warn(int(t["line"][i]), 1, f"{code} is not a {self.flavor.name} code; kept as a generic command")
+            line = int(t["line"][i])
+            if self.flavor.other_codes and code not in self.flavor.other_codes:
+                # the dialect's list is complete: LinuxCNC stops here (convert_g / convert_m)
+                self.diagnostics.report(line, 1, f"Unknown {code[0].lower()} code used: {code} "
+                                        f"is not a {self.flavor.name} code", kind="machine")
+            else:
+                self.diagnostics.warn(line, 1, f"{code} is not a {self.flavor.name} code; kept as a generic command")
 
 
 def _forward_fill_modes(sets: np.ndarray, initial: int) -> np.ndarray:

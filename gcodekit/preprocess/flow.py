@@ -238,6 +238,7 @@ class _Run:
                 items = self.code.items
                 if self.pc >= len(items):
                     if not self.frames:
+                        self._file_ended(lines)
                         return
                     self._return()  # a sub without endsub: reported when matched
                     continue
@@ -252,6 +253,21 @@ class _Run:
                     yield from self._plain(st)
         except _Stop:
             return
+
+    def _file_ended(self, lines: list[SourceLine]) -> None:
+        """The main program ran out of lines without M2/M30: LinuxCNC's ``read_text``
+        (interp_read.cc) fails on the last line read unless a ``%`` line closed
+        the program opened by a ``%`` first line.  Only program files: text given
+        as a string is taken as MDI blocks, which need no end."""
+        if not (self.stage.flavor.percent_delimiter and lines and os.path.isfile(lines[0].file)):
+            return
+        marks = [k for k, s in enumerate(lines) if s.text.strip() == "%"]
+        opened = bool(marks) and not any(s.text.strip() for s in lines[:marks[0]])
+        if opened and len(marks) > 1:
+            return
+        last = lines[-1]
+        message = "File ended with no percent sign" if opened else "File ended with no percent sign or program end"
+        self._report(last, 1, message + " (M2 or M30)" * (not opened), kind="machine")
 
     def _oword(self, st: OWord) -> None:
         if not st.valid:

@@ -125,6 +125,11 @@ class Flavor:
         See :data:`BLOCK_SPLITS`.
     string_codes : frozenset of str
         Codes whose remaining text is one string argument (``M117 Hello``).
+    other_codes : frozenset of str
+        Codes the dialect knows that have no normalized command yet: kept as
+        generic commands with a warning.  When not empty, the dialect's code
+        list is complete and any other G/M code is an error (LinuxCNC's
+        "Unknown g code used").
     extended_commands : bool
         Klipper-style ``NAME KEY=VALUE`` commands are accepted.
     wizards : bool
@@ -180,6 +185,7 @@ class Flavor:
     percent_delimiter: bool = False
     block_split: str = "single"
     string_codes: frozenset[str] = frozenset()
+    other_codes: frozenset[str] = frozenset()
     extended_commands: bool = False
     wizards: bool = False
     code_assignments: bool = False

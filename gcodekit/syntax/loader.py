@@ -270,8 +270,9 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
                 raise ConfigError(
                     f"{path}: [codes] {code}: extended command names need extended_commands = true"
                 )
-    for code in get("string_codes"):
-        _check_code(code, f"{path}: string_codes: {code}")
+    for key in ("string_codes", "other_codes"):
+        for code in get(key):
+            _check_code(code, f"{path}: {key}: {code}")
     for code in detect.get("codes", ()):
         _check_code(code, f"{path}: [detect] codes: {code}")
     for pattern in get("layer_comments"):
@@ -287,7 +288,7 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
     values: dict[str, Any] = {}
     for key, kind in _FLAVOR_KEYS.items():
         if key in data and kind == "list":
-            values[key] = frozenset(data[key]) if key == "string_codes" else tuple(data[key])
+            values[key] = frozenset(data[key]) if key in ("string_codes", "other_codes") else tuple(data[key])
         elif key in data and kind != "table" and key not in _EXTRA_KEYS:
             values[key] = data[key]
     rules = {k: tuple(v) if isinstance(v, list) else v for k, v in detect.items()}
