@@ -356,3 +356,14 @@ def test_random_flow_never_hangs_and_raises_only_gcodekit_errors(program):
     assert len(out) <= 5_000
     lenient = Diagnostics("r.ngc", mode="lenient")
     list(ControlFlowStage(NGC, max_iterations=200, max_lines=5_000).process(lines, lenient))
+
+
+def test_return_with_another_label_leaves_the_sub_like_rs274():
+    """LinuxCNC's retval.ngc: ``o1010 return [v]`` inside ``o1000 sub`` returns v from o1000."""
+    text = ("o1000 sub\no1010 if [#1 GT 0]\no1010 return [123*#1]\no1010 endif\no1000 endsub [4712]\n"
+            "o1000 call [0]\nG0 X#<_value>\no1000 call [2]\nG0 X#<_value>\nM2\n")
+    import gcodekit
+
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+    assert op.motions()["x"].tolist() == [4712.0, 246.0]
+    assert not op.diagnostics.items

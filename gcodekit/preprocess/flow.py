@@ -664,11 +664,11 @@ class _Run:
                 if j is not None:
                     st.start = j
             elif k == "return":
+                # rs274 returns from the enclosing sub whatever the return's own label
+                # (LinuxCNC's retval.ngc writes "o1010 return" inside "o1000 sub")
                 if not stack or items[stack[0]].keyword != "sub":
                     self._report(st.line, st.column, f"{st.name} is not inside a subroutine")
                     st.valid = False
-                elif items[stack[0]].label != st.label:
-                    self._report(st.line, st.column, f"{st.name} inside {items[stack[0]].name}")
         for j in reversed(stack):
             self._unclosed(items, j, None, branches)
         return code
