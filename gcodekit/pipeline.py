@@ -193,6 +193,10 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         waypoints, sizes = [m.run(table)], [0]
     op = cls(table, _concat_waypoints(waypoints, sizes), file=program.name,
              flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
+    from .emulate.compensation import compensate, uses_compensation
+
+    if uses_compensation(op):
+        compensate(op, m.tools)
     if plan and config.planner:
         from .emulate.planners import planner_settings, run_planner
 

@@ -270,8 +270,8 @@ def test_tool_length_offsets_g10_and_g52(tmp_path):
     table.write_text("T1 P1 Z0.5 D0.25 ;end mill\nT2 P2 Z1.0\n")
     text = "\n".join([
         "G20 T1 M6",
-        "G43 H1",            # tool 1: +0.5 in; the program position stays 0
-        "G0 X1",             # ... so the machine reaches Z 0.5 in on this move
+        "G43 H1",            # tool 1: +0.5 mm; the machine stays, program Z becomes -0.5 mm
+        "G0 X1",             # ... so Z does not move (rs274, gmoccapy golden case)
         "G43.2 H2",          # add tool 2: 1.5 in in all
         "G0 Z0",
         "G49 G0 Z0",
@@ -281,12 +281,22 @@ def test_tool_length_offsets_g10_and_g52(tmp_path):
         "G54 G0 X1",
         "G52 X0.5",          # LinuxCNC: a local offset kept in the G92 slot
         "G0 X1",
-        "G43.1 Z-0.25 G0 Z0",
+        "G43.1 Z-0.25",
+        "G0 Z0",
     ]) + "\n"
     op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, tool_table=table, tool_table_units="mm")
     m = op.motions()
     np.testing.assert_allclose(m[["x", "z"]].to_numpy(), [
-        [1, 0.5 / 25.4], [1, 1.5 / 25.4], [1, 0], [2, 0], [2, 0], [2.5, 0], [2.5, -0.25]], atol=1e-12)
+        [1, 0], [1, 1.5 / 25.4], [1, 0], [2, 0], [2, 0], [2.5, 0], [2.5, -0.25]], atol=1e-12)
+
+
+def test_tool_length_offset_in_the_tool_change_block_keeps_program_position(tmp_path):
+    """rs274 re-reads its position after M6, so G43 in that block moves Z on the next move (skeleton.ngc)."""
+    table = tmp_path / "tools.tbl"
+    table.write_text("T1 P1 Z0.5\n")
+    op = gcodekit.gcode_to_operation("G21 T1 M6 G43 H1\nG0 X1\n", "linuxcnc", plan=False,
+                                     tool_table=table, tool_table_units="mm")
+    np.testing.assert_allclose(op.motions()[["x", "z"]].to_numpy(), [[1, 0.5]], atol=1e-12)
 
 
 def test_canned_cycles_follow_linuxcnc():

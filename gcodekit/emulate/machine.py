@@ -179,7 +179,7 @@ class Machine:
         for ax, letter in enumerate(AXES):
             col = t.params.get(letter)
             if col is None:
-                position[:, ax] = s.position[ax]
+                position[:, ax] = program[ax] + offset[ax]
                 continue
             values = _dense(col, rows) * scale[ax]
             values[~moving] = np.nan

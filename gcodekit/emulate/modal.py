@@ -62,6 +62,7 @@ class ModalHandler:
         self.machine = machine
         self.special_ids = np.array(sorted(NAME_ID[n] for n in SPECIAL_NAMES), np.uint8)
         self._last_dwell = 0.0  # dwell at the end of a canned cycle's last move
+        self._tool_change_line = -1  # source line of the last M6 (see tool length offsets)
 
     @property
     def state(self) -> MachineState:
@@ -116,6 +117,8 @@ class ModalHandler:
             s.flow = params.get("S", 100.0) / 100.0
         elif name == "tool_change" or chr(int(t.letter[row])) == "T":
             self._tool(t, row, params)
+            if name == "tool_change":
+                self._tool_change_line = line
         elif name in ("spindle_cw", "spindle_ccw", "spindle_off"):
             s.spindle = {"spindle_cw": 1, "spindle_ccw": -1, "spindle_off": 0}[name]
             s.speed = params.get("S", s.speed)
@@ -128,7 +131,10 @@ class ModalHandler:
         elif name in ("tool_length_offset", "tool_length_offset_add"):
             number = params.get("H", s.tool)
             offset = self.machine.tools.offset(int(number))
-            s.change_tool_offset(offset if name == "tool_length_offset" else s.tool_offset + offset)
+            # rs274 re-reads its position after a tool change, so a G43 in the
+            # M6 block keeps the program position; elsewhere the machine stays.
+            s.change_tool_offset(offset if name == "tool_length_offset" else s.tool_offset + offset,
+                                 keep_program_position=line == self._tool_change_line)
         elif name == "tool_length_offset_dynamic":
             scale = s.scale()
             s.change_tool_offset([params.get(letter, 0.0) * scale[ax] for ax, letter in enumerate(AXES)])

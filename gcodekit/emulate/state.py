@@ -67,11 +67,17 @@ class MachineState:
     def program_position(self) -> np.ndarray:
         return self.position - self.offset + self.program_shift
 
-    def change_tool_offset(self, offset: np.ndarray) -> None:
-        """New tool length offset; the program position stays (no motion)."""
+    def change_tool_offset(self, offset: np.ndarray, keep_program_position: bool = False) -> None:
+        """New tool length offset, taking effect without motion.
+
+        Normally the machine stays and the program position shifts by the
+        change; with ``keep_program_position`` the program position stays and
+        the machine catches up on the next move.
+        """
         before = self.program_position()
         self.tool_offset = np.asarray(offset, float).copy()
-        self.program_shift = before - (self.position - self.offset)
+        if keep_program_position:
+            self.program_shift = before - (self.position - self.offset)
 
     def scale(self) -> np.ndarray:
         """Program units to mm per axis (rotary axes stay in degrees)."""

@@ -66,11 +66,13 @@ _value _value_returned _task _call_level _remap_level
 #: Programs gcodekit knows it does not reproduce yet, and why.
 KNOWN_GAPS = {
     "nc_files/polar.ngc": "rs274 starts each modal canned-cycle block with an extra zero-length rapid (not modelled)",
+    "nc_files/useful-subroutines.ngc": "after G40, rs274 keeps the compensated XY on one Z-only move but not on a zero-length one (not modelled)",
+    "nc_files/lathecomp.ngc": "XZ-plane compensation of a lathe program: corner rule and feed differ (not modelled)",
 }
 
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
 EXCLUDED_G = {
-    **dict.fromkeys(("41", "41.1", "42", "42.1"), "cutter compensation"),
+    **dict.fromkeys(("41.1", "42.1"), "dynamic cutter compensation"),
     **dict.fromkeys(("74", "76", "84", "87", "88"), "canned cycle not emulated yet"),
     **dict.fromkeys(("33", "33.1"), "threading"),
     **dict.fromkeys(("38.2", "38.3", "38.4", "38.5"), "probing"),
@@ -79,7 +81,7 @@ EXCLUDED_G = {
     **dict.fromkeys(("70", "71", "71.1", "71.2", "72", "72.1", "72.2"), "lathe cycle"),
 }
 ALLOWED_G = frozenset("""
-0 1 2 3 4 10 17 17.1 73 81 82 83 85 86 89 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 43 43.1 43.2 49 52 53 54 55 56 57 58
+0 1 2 3 4 10 17 17.1 73 81 82 83 85 86 89 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 41 42 43 43.1 43.2 49 52 53 54 55 56 57 58
 59 59.1 59.2 59.3 61 61.1 64 80 90 90.1 91 91.1 92 92.1 92.2 92.3 93 94 95 96 97
 98 99
 """.split())

@@ -1,0 +1,189 @@
+"""Emulate stage: cutter radius compensation (G41/G42, in the active plane), LinuxCNC's way.
+
+The machine first computes the programmed path; this pass then moves the
+tool off it by the tool radius, after the rules of LinuxCNC's interpreter
+(interp_convert.cc, ``convert_straight_comp1/2`` and ``convert_arc_comp1/2``):
+
+* the first move after G41/G42 (the entry) runs to its programmed end
+  shifted by the radius to the left (G41) or right (G42) of that move: a
+  line straight there, an arc on a centre moved along its end radius;
+* every later move is shifted the same way (an arc's radius grows or shrinks
+  by the tool radius); at an outside corner the tool rolls round the
+  programmed corner on an arc of the tool radius, at an inside corner the
+  previous move is cut short where the two shifted paths meet;
+* the first move after G40 (the exit) runs straight to its programmed end.
+
+Runs once over the emulated waypoints of programs that use G41/G42; it is a
+per-move Python loop because each corner depends on the move before.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, NAME_ID
+from .arcs import PLANES, arc_length, sweep
+
+if TYPE_CHECKING:
+    from .operation import Operation
+
+_SIDES = {NAME_ID["cutter_comp_left"]: 1, NAME_ID["cutter_comp_right"]: -1, NAME_ID["cutter_comp_off"]: 0}
+_TINY = 1e-9
+
+
+def uses_compensation(op: "Operation") -> bool:
+    return bool(np.isin(op.table.name, list(_SIDES)[:2]).any())
+
+
+def compensate(op: "Operation", tools) -> None:
+    """Rewrite ``op.waypoints`` with the compensated tool path (in place)."""
+    w = op.waypoints
+    t = op.table
+    n = w["x"].size
+    rows = w["command"] if "command" in w else np.arange(n)
+    columns = {k: np.array(v, copy=True) for k, v in w.items()}
+    columns["command"] = np.asarray(rows)  # corner arcs are added: every waypoint names its command
+    out = {k: [] for k in columns}
+    side, radius, mode = 0, 0.0, "off"  # mode: off, entry, on, exit
+    last_dir = None  # tangent at the end of the previous compensated move
+    last_corner = None  # programmed end of the previous move
+    pending = None  # index in `out` of the previous compensated waypoint
+    side_rows = {int(r): _SIDES[int(t.name[r])] for r in np.flatnonzero(np.isin(t.name, list(_SIDES)))}
+    current_row = -1
+
+    def emit(k: int, **changes) -> int:
+        for key in columns:
+            out[key].append(changes.get(key, columns[key][k]))
+        return len(out["x"]) - 1
+
+    for k in range(n):
+        row = int(rows[k])
+        if row != current_row:
+            for r in range(current_row + 1, row + 1):  # comp codes between the waypoints
+                if r in side_rows:
+                    new = side_rows[r]
+                    if new and not side:
+                        side, mode = new, "entry"
+                        params = t.command(r).params
+                        number = int(params.get("D", columns["tool"][k]))
+                        radius = tools[number].diameter / 2.0 if number in tools else 0.0
+                    elif not new and side:
+                        side, mode = 0, "exit"
+            current_row = row
+        motion = int(columns["motion"][k])
+        (f, g, _), _ = PLANES[int(columns["plane"][k])]
+        a, b = "xyz"[f], "xyz"[g]
+        if mode == "off" or radius <= 0:
+            emit(k)
+            continue
+        if motion == 0:  # a command without motion stays where the tool is
+            emit(k, **({a: out[a][-1], b: out[b][-1]} if out["x"] else {}))
+            continue
+        ca, cb = "c" + a, "c" + b
+        start = np.array([out[a][-1], out[b][-1]]) if out["x"] else np.zeros(2)
+        end = np.array([columns[a][k], columns[b][k]])
+        programmed_start = last_corner if last_corner is not None else start
+        if mode == "exit":
+            emit(k)  # straight from the compensated point to the programmed end
+            mode, last_dir, last_corner, pending = "off", None, None, None
+            continue
+        chord = end - programmed_start
+        if np.hypot(*chord) < _TINY and motion < MOTION_CW:  # a move along the plane's normal keeps the offset
+            emit(k, **{a: start[0], b: start[1]})
+            continue
+        if motion in (MOTION_CW, MOTION_CCW):
+            center = np.array([columns[ca][k], columns[cb][k]])
+            ccw = motion == MOTION_CCW
+            r0 = np.hypot(*(programmed_start - center))
+            r1 = np.hypot(*(end - center))
+            grow = -side if ccw else side  # G41 on a CCW arc is inside it
+            new_r1 = r1 + grow * radius
+            in_dir = _unit(np.array([-(programmed_start - center)[1], (programmed_start - center)[0]]) * (1 if ccw else -1))
+            out_dir = _unit(np.array([-(end - center)[1], (end - center)[0]]) * (1 if ccw else -1))
+            new_start = center + (programmed_start - center) / r0 * (r0 + grow * radius)
+            new_end = center + (end - center) / r1 * new_r1
+        else:
+            in_dir = out_dir = _unit(chord)
+            normal = _left(in_dir) * side * radius
+            new_start, new_end = programmed_start + normal, end + normal
+        if mode == "entry" and motion in (MOTION_CW, MOTION_CCW):
+            # comp1 arc: from the current point to the radially shifted end, on a
+            # centre moved along the end radius so the arc leaves on the same tangent
+            entry_center = _meet(center, _unit(end - center), (start + new_end) / 2, _left(_unit(new_end - start)))
+            if entry_center is None:
+                entry_center = center
+            pending = emit(k, **{a: new_end[0], b: new_end[1], ca: entry_center[0], cb: entry_center[1]})
+            mode, last_dir, last_corner = "on", out_dir, end
+            continue
+        if mode == "entry":
+            # comp1: straight to the end shifted off the entry move's own direction
+            shifted = end + _left(_unit(chord)) * side * radius
+            pending = emit(k, **{a: shifted[0], b: shifted[1]})
+            mode, last_dir, last_corner = "on", _unit(chord), end
+            continue
+        turn = last_dir[0] * in_dir[1] - last_dir[1] * in_dir[0]
+        gap = np.hypot(*(new_start - start))
+        if gap > _TINY:
+            if turn * side < 0:  # outside corner: roll round the programmed corner
+                length = radius * _angle(start, new_start, programmed_start)
+                feed = float(columns["feed"][k])
+                emit(k, **{a: new_start[0], b: new_start[1], ca: programmed_start[0], cb: programmed_start[1]},
+                     motion=MOTION_CCW if side < 0 else MOTION_CW, distance=length, de=0.0,
+                     time=length / (feed / 60.0) if feed > 0 else 0.0)
+            elif pending is not None and motion < MOTION_CW:
+                # inside corner: cut the previous move where the two shifted lines meet
+                meet = _meet(start, last_dir, new_start, in_dir)
+                if meet is not None:
+                    out[a][pending], out[b][pending] = meet[0], meet[1]
+                    new_start = meet
+        centre = (columns[ca][k], columns[cb][k]) if motion in (MOTION_CW, MOTION_CCW) else (np.nan, np.nan)
+        pending = emit(k, **{a: new_end[0], b: new_end[1], ca: centre[0], cb: centre[1]})
+        last_dir, last_corner = out_dir, end
+    for key in columns:
+        w[key] = np.asarray(out[key], dtype=columns[key].dtype)
+    _recompute_lengths(w)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    norm = float(np.hypot(*v))
+    return v / norm if norm > _TINY else np.zeros(2)
+
+
+def _left(d: np.ndarray) -> np.ndarray:
+    return np.array([-d[1], d[0]])
+
+
+def _meet(p: np.ndarray, d: np.ndarray, q: np.ndarray, e: np.ndarray):
+    """Where the lines p + s·d and q + u·e cross (None when parallel)."""
+    det = d[0] * e[1] - d[1] * e[0]
+    if abs(det) < _TINY:
+        return None
+    s = ((q - p)[0] * e[1] - (q - p)[1] * e[0]) / det
+    return p + s * d
+
+
+def _angle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
+    return abs(math.atan2((a - c)[0] * (b - c)[1] - (a - c)[1] * (b - c)[0], float(np.dot(a - c, b - c))))
+
+
+def _recompute_lengths(w: dict) -> None:
+    """Move lengths after the path moved: straight moves and arcs in their plane."""
+    points = np.column_stack([np.asarray(w[k], float) for k in "xyz"])
+    centers = np.column_stack([np.asarray(w["c" + k], float) for k in "xyz"])
+    previous = np.vstack([np.zeros(3), points[:-1]])
+    motion = np.asarray(w["motion"])
+    distance = np.array(w["distance"], float)
+    straight = motion <= MOTION_LINEAR
+    distance[straight] = np.linalg.norm(points - previous, axis=1)[straight]
+    plane = np.asarray(w["plane"])
+    arcs = np.isin(motion, (MOTION_CW, MOTION_CCW))
+    for code in np.unique(plane[arcs]):
+        (f, g, h), _ = PLANES[int(code)]
+        idx = np.flatnonzero(arcs & (plane == code))
+        p0, p1, c = previous[idx][:, [f, g]], points[idx][:, [f, g]], centers[idx][:, [f, g]]
+        angle = sweep(p0, p1, c, motion[idx] == MOTION_CW, np.ones(idx.size))
+        distance[idx] = arc_length(np.hypot(*(p0 - c).T), angle, points[idx, h] - previous[idx, h])
+    w["distance"] = distance
