@@ -40,6 +40,17 @@ def test_last_stage_moves_like_the_original(path):
     np.testing.assert_allclose(b, a, atol=1e-3, equal_nan=True)  # 4 decimals in the output
 
 
+@pytest.mark.parametrize("stage", [4, 5])
+def test_compensated_program_moves_alike_from_stage_4(stage):
+    """From stage 4 moves come from compensated waypoints: G41/G42 must not apply twice."""
+    from test_linuxcnc_golden import tool_table
+
+    original = operation(GOLDEN / "comp.ngc")
+    again = gcodekit.gcode_to_operation(Transpiler(original).stage(stage), "linuxcnc", plan=False,
+                                        tool_table=tool_table("comp.ngc"), tool_table_units="inch")
+    np.testing.assert_allclose(path_of(again), path_of(original), atol=1e-3, equal_nan=True)
+
+
 @pytest.mark.parametrize("path", PROGRAMS[:4] + [EXAMPLES / "bracket_mill.ngc"], ids=lambda p: p.name)
 def test_every_stage_reads_back_without_errors(path):
     t = Transpiler(operation(path))

@@ -9,7 +9,8 @@ with canned cycles):
 2. work offsets, G92, G52 and tool-length offsets applied (machine coordinates);
 3. polar words turned into X and Y;
 4. incremental moves written as absolute ones (G90/G91 gone);
-5. cutter compensation applied;
+5. cutter compensation applied (moves are written from the compensated
+   waypoints from stage 4 on, so G40/G41/G42 already go at stage 4);
 6. canned cycles expanded into the moves they make.
 
 The last stage uses only G0/G1/G2/G3 (arcs outside XY carry their G18/G19),
@@ -126,7 +127,7 @@ class Transpiler:
         if motion_row and (k >= 4 or (k >= 3 and ("@" in cmd.params or "^" in cmd.params))):
             return self._from_waypoints(row, k, moving, comment)
         if (k >= 1 and name in _UNITS) or (k >= 2 and name in _OFFSETS) or (k >= 4 and name in _DISTANCE) \
-                or (k >= 5 and name in _COMP) or (k >= 6 and name in _CYCLE_MODES):
+                or (k >= 4 and name in _COMP) or (k >= 6 and name in _CYCLE_MODES):
             return [f"({n} {_paren(str(cmd))} resolved)"] if k < 6 else []
         if k >= 6 and not motion_row and name not in _KEPT and kind not in (Kind.FEED_RATE, Kind.MILL):
             return [f"(dropped: {n} {_paren(str(cmd))})"]
