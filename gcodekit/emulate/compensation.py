@@ -49,6 +49,7 @@ def compensate(op: "Operation", tools) -> None:
     out = {k: [] for k in columns}
     side, radius, mode = 0, 0.0, "off"  # mode: off, entry, on, exit
     last_dir = None  # tangent at the end of the previous compensated move
+    last_path = None  # its offset path: ("line", point, direction) or ("arc", centre, radius)
     last_corner = None  # programmed end of the previous move
     pending = None  # index in `out` of the previous compensated waypoint
     side_rows = {int(r): _SIDES[int(t.name[r])] for r in np.flatnonzero(np.isin(t.name, list(_SIDES)))}
@@ -88,7 +89,7 @@ def compensate(op: "Operation", tools) -> None:
         programmed_start = last_corner if last_corner is not None else start
         if mode == "exit":
             emit(k)  # straight from the compensated point to the programmed end
-            mode, last_dir, last_corner, pending = "off", None, None, None
+            mode, last_dir, last_corner, pending, last_path = "off", None, None, None, None
             continue
         chord = end - programmed_start
         if np.hypot(*chord) < _TINY and motion < MOTION_CW:  # a move along the plane's normal keeps the offset
@@ -117,14 +118,17 @@ def compensate(op: "Operation", tools) -> None:
                 entry_center = center
             pending = emit(k, **{a: new_end[0], b: new_end[1], ca: entry_center[0], cb: entry_center[1]})
             mode, last_dir, last_corner = "on", out_dir, end
+            last_path = ("arc", entry_center, float(np.hypot(*(new_end - entry_center))))
             continue
         if mode == "entry":
             # comp1: straight to the end shifted off the entry move's own direction
             shifted = end + _left(_unit(chord)) * side * radius
             pending = emit(k, **{a: shifted[0], b: shifted[1]})
             mode, last_dir, last_corner = "on", _unit(chord), end
+            last_path = ("line", shifted, _unit(chord))
             continue
         turn = last_dir[0] * in_dir[1] - last_dir[1] * in_dir[0]
+        this_path = ("arc", center, new_r1) if motion in (MOTION_CW, MOTION_CCW) else ("line", new_start, in_dir)
         gap = np.hypot(*(new_start - start))
         if gap > _TINY:
             if turn * side < 0:  # outside corner: roll round the programmed corner
@@ -133,15 +137,15 @@ def compensate(op: "Operation", tools) -> None:
                 emit(k, **{a: new_start[0], b: new_start[1], ca: programmed_start[0], cb: programmed_start[1]},
                      motion=MOTION_CCW if side < 0 else MOTION_CW, distance=length, de=0.0,
                      time=length / (feed / 60.0) if feed > 0 else 0.0)
-            elif pending is not None and motion < MOTION_CW:
-                # inside corner: cut the previous move where the two shifted lines meet
-                meet = _meet(start, last_dir, new_start, in_dir)
+            elif pending is not None:
+                # inside corner: cut the previous move where the two offset paths meet
+                meet = _crossing(last_path, this_path, new_start)
                 if meet is not None:
                     out[a][pending], out[b][pending] = meet[0], meet[1]
                     new_start = meet
         centre = (columns[ca][k], columns[cb][k]) if motion in (MOTION_CW, MOTION_CCW) else (np.nan, np.nan)
         pending = emit(k, **{a: new_end[0], b: new_end[1], ca: centre[0], cb: centre[1]})
-        last_dir, last_corner = out_dir, end
+        last_dir, last_corner, last_path = out_dir, end, this_path
     for key in columns:
         w[key] = np.asarray(out[key], dtype=columns[key].dtype)
     _recompute_lengths(w)
@@ -154,6 +158,40 @@ def _unit(v: np.ndarray) -> np.ndarray:
 
 def _left(d: np.ndarray) -> np.ndarray:
     return np.array([-d[1], d[0]])
+
+
+def _crossing(first: tuple, second: tuple, near: np.ndarray):
+    """Where two offset paths (lines or circles) cross, the crossing nearest ``near``."""
+    if first[0] == "line" and second[0] == "line":
+        return _meet(first[1], first[2], second[1], second[2])
+    if first[0] == "arc" and second[0] == "arc":
+        points = _circles_cross(first[1], first[2], second[1], second[2])
+    else:
+        line, circle = (first, second) if first[0] == "line" else (second, first)
+        points = _line_circle_cross(line[1], line[2], circle[1], circle[2])
+    return min(points, key=lambda p: float(np.hypot(*(p - near))), default=None)
+
+
+def _line_circle_cross(p: np.ndarray, d: np.ndarray, c: np.ndarray, r: float) -> list[np.ndarray]:
+    f = p - c
+    b, cc = float(f @ d), float(f @ f) - r * r  # d is a unit vector
+    disc = b * b - cc
+    if disc < 0:
+        return []
+    root = math.sqrt(disc)
+    return [p + (-b - root) * d, p + (-b + root) * d]
+
+
+def _circles_cross(c0: np.ndarray, r0: float, c1: np.ndarray, r1: float) -> list[np.ndarray]:
+    gap = c1 - c0
+    dist = float(np.hypot(*gap))
+    if dist < _TINY or dist > r0 + r1 or dist < abs(r0 - r1):
+        return []
+    along = (r0 * r0 - r1 * r1 + dist * dist) / (2 * dist)
+    half = math.sqrt(max(r0 * r0 - along * along, 0.0))
+    base = c0 + gap * along / dist
+    across = _left(gap / dist) * half
+    return [base + across, base - across]
 
 
 def _meet(p: np.ndarray, d: np.ndarray, q: np.ndarray, e: np.ndarray):

@@ -80,7 +80,9 @@ class ModalHandler:
             self._write(out, row, before, MOTION_NONE)
             return []
         if "F" in params and (chr(int(t.letter[row])) != "M" or self.machine.rs274_blocks):
-            s.feed = params["F"] * s.units
+            # an F beside G20/G21 is in the block's new units (rs274: "G20 F60" is 60 in/min)
+            units = _SIMPLE[name][1] if name in ("units_inch", "units_mm") else s.units
+            s.feed = params["F"] * units
         moves = int(t.kind[row]) in _MOVING_KINDS
         if moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
             motion, extra = self._cycle(name, params, line)
