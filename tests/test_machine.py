@@ -330,3 +330,26 @@ def test_inverse_time_feed_is_not_scaled_by_inches():
     _, df = run("G20 G93 G1 X1 F2\n")  # 1 inch in 1/2 minute, whatever the units
     assert df["time"].iloc[-1] == pytest.approx(30.0)
     assert df["feed"].iloc[-1] == pytest.approx(2 * 25.4)  # mm/min actually travelled
+
+
+def test_g16_polar_fanuc_absolute_pole_at_origin():
+    # G90: X radius, Y angle about the program origin; a missing word keeps its last value
+    text = "G21 G90 G17 G54 G0 X0 Y0\nG16\nG1 X10 Y30 F100\nY90\nX5\nG15\nG1 X1 Y1\n"
+    m = gcodekit.gcode_to_operation(text, "fanuc", plan=False).motions()
+    np.testing.assert_allclose(m[["x", "y"]].to_numpy(), [
+        [0, 0], [10 * math.cos(math.radians(30)), 5], [0, 10], [0, 5], [1, 1]], atol=1e-12)
+
+
+def test_g16_polar_ger_incremental_pole_at_tool():
+    # GER: polar only in G91, each move X long at angle Y from where the tool is
+    text = "G21 G91\nG16\nG01 X10 Y90 F100\nX10 Y0\nX2 Y180\nG15\nG01 X1 Y1\n"
+    op = gcodekit.gcode_to_operation(text, "ger", plan=False)
+    np.testing.assert_allclose(op.motions()[["x", "y"]].to_numpy(), [[0, 10], [10, 10], [8, 10], [9, 11]],
+                               atol=1e-12)
+    assert not op.diagnostics.items
+
+
+def test_g16_refuses_arcs():
+    op = gcodekit.gcode_to_operation("G21 G91 G16\nG02 X10 Y10 I5 J0\n", "ger", plan=False)
+    assert [(d.line, d.severity) for d in op.diagnostics] == [(2, "error")]
+    assert "G16" in op.diagnostics.items[0].message

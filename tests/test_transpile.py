@@ -72,3 +72,18 @@ def test_last_stage_vocabulary_and_line_numbers():
 def test_stage_1_converts_units():
     t = Transpiler("G20 G91 G0 X1\nG1 X0.5 F10\n", "linuxcnc")
     assert "N1 G0 X25.4" in t.stage(1) and "N2 G1 F254 X12.7" in t.stage(1)
+
+
+@pytest.mark.parametrize("flavor, text", [
+    ("fanuc", "G21 G90 G17 G0 X0 Y0\nG55\nG16\nG1 X10 Y30 F100\nY90\nG15\nG1 X1 Y1\n"),
+    ("ger", "G21 G91\nG16\nG01 X10 Y90 F100\nX10 Y0\nG15\nG01 X1 Y1\n"),
+])
+def test_g16_polar_moves_alike_at_every_stage(flavor, text):
+    t = Transpiler(text, flavor, work_offsets={"G55": (100.0, 50.0, 0.0)})
+    reference = path_of(t.op)
+    for k in STAGES:
+        out = t.stage(k)
+        code_lines = [line for line in out.splitlines() if not line.startswith("(")]
+        assert any("G16" in line for line in code_lines) == (k < 2), f"stage {k}"
+        again = gcodekit.gcode_to_operation(out, flavor, plan=False, work_offsets={"G55": (100.0, 50.0, 0.0)})
+        np.testing.assert_allclose(path_of(again), reference, atol=1e-3, equal_nan=True, err_msg=f"stage {k}")

@@ -48,6 +48,17 @@ _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTR
 _MILL = np.array([Kind.MILL, Kind.MOVE_MILL, Kind.ARC_MILL], np.uint8)
 
 
+def polar_mode_rows(table: CommandTable, initially: bool = False) -> np.ndarray:
+    """Which rows run while G16 polar coordinates are in force (table order)."""
+    switches = np.full(len(table), -1, np.int8)
+    switches[table.name == NAME_ID["polar_on"]] = 1
+    switches[table.name == NAME_ID["polar_off"]] = 0
+    if not (switches >= 0).any():
+        return np.full(len(table), initially)
+    last = np.maximum.accumulate(np.where(switches >= 0, np.arange(len(table)), -1))
+    return np.where(last >= 0, switches[np.maximum(last, 0)], int(initially)) == 1
+
+
 class Machine:
     """A modal machine that emulates command tables chunk by chunk.
 
@@ -98,6 +109,7 @@ class Machine:
         special |= (table.motion == MOTION_CYCLE) & np.isin(table.kind, _MOVING)
         if self.rs274_blocks:
             self._check_axis_words(table)
+        special |= polar_mode_rows(table, self.state.polar) & np.isin(table.kind, _MOVING)
         for letter in "@^":  # polar words depend on where the tool is: one block at a time
             if letter in table.params:
                 special |= ~np.isnan(table.param(letter)) & np.isin(table.kind, _MOVING)

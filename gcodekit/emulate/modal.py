@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..parse.table import MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, NAMES, CommandTable
+from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, NAMES,
+                           CommandTable)
 from ..parse.commands import Kind
 from .cycles import CYCLES, polar_target, run_cycle
 from .state import AXES, MachineState
@@ -33,7 +34,7 @@ SPECIAL_NAMES = frozenset(
     coolant_mist coolant_flood coolant_off program_end machine_coordinates
     firmware_retract firmware_unretract set_kinematic_position
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
-    coordinate_data local_offset retract_initial retract_r laser_on laser_off""".split()
+    coordinate_data local_offset retract_initial retract_r laser_on laser_off polar_on polar_off""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)}
 
 _MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
@@ -45,6 +46,7 @@ _SIMPLE = {
     "feed_inverse_time": ("feed_mode", "inverse_time"), "feed_per_minute": ("feed_mode", "per_minute"),
     "feed_per_rev": ("feed_mode", "per_rev"),
     "extrude_absolute": ("e_relative", False), "extrude_relative": ("e_relative", True),
+    "polar_on": ("polar", True), "polar_off": ("polar", False),
 }
 
 
@@ -88,6 +90,8 @@ class ModalHandler:
             motion, extra = self._cycle(name, params, line)
         elif moves and ("@" in params or "^" in params):
             motion = self._polar_move(params, int(t.motion[row]), line)
+        elif s.polar and (moves or int(t.motion[row]) in (MOTION_CW, MOTION_CCW)):
+            motion = self._radius_angle_move(params, int(t.motion[row]), line)
         elif name in ("retract_initial", "retract_r"):
             s.cycle.retract_to_r = name == "retract_r"
         elif name in _SIMPLE:
@@ -196,6 +200,34 @@ class ModalHandler:
         s.position = steps[-1].point.copy()
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
+
+    def _radius_angle_move(self, params: dict, motion: int, line: int) -> int:
+        """G0/G1 under G16 (Fanuc, GER): X the radius, Y the angle in degrees.
+
+        In G90 the pole is the program origin and a missing word keeps the
+        last polar value; in G91 the pole is the current point (the move is
+        X long at angle Y), as GER requires.  Arcs are refused, as GER does.
+        """
+        s = self.state
+        if motion not in (MOTION_RAPID, MOTION_LINEAR) or s.plane != 17:
+            self.machine.diagnostics.report(line, 1, "G16 polar coordinates allow only G0 and G1 in the XY plane",
+                                            kind="machine")
+            return MOTION_NONE
+        program = s.program_position()
+        scale = s.scale()
+        if s.incremental:
+            radius, angle = params.get("X", 0.0) * scale[0], np.radians(params.get("Y", 0.0))
+            program[[0, 1]] += radius * np.array([np.cos(angle), np.sin(angle)])
+        else:
+            radius = params["X"] * scale[0] if "X" in params else float(np.hypot(*program[[0, 1]]))
+            angle = np.radians(params["Y"]) if "Y" in params else float(np.arctan2(program[1], program[0]))
+            program[[0, 1]] = radius * np.array([np.cos(angle), np.sin(angle)])
+        for ax, letter in enumerate(AXES):
+            if letter in params and letter not in "XY":
+                program[ax] = program[ax] + params[letter] * scale[ax] if s.incremental else params[letter] * scale[ax]
+        s.position = program + s.offset
+        s.program_shift[:] = 0.0
+        return motion
 
     def _polar_move(self, params: dict, motion: int, line: int) -> int:
         """G0/G1 with ``@``/``^``: the X/Y end point in polar form (LinuxCNC, XY plane only)."""

@@ -30,6 +30,7 @@ class MachineState:
     position: np.ndarray = field(default_factory=_zeros)
     units: float = 1.0  # mm per program unit: 1 (G21) or 25.4 (G20)
     incremental: bool = False  # G91
+    polar: bool = False  # G16 (Fanuc, GER): X is a radius, Y an angle in degrees
     arc_incremental: bool = True  # G91.1 (the default) or G90.1
     plane: int = 17
     feed: float = np.nan  # mm/min, or 1/min in inverse-time mode
@@ -42,9 +43,9 @@ class MachineState:
     work_offsets: np.ndarray = field(default_factory=lambda: np.zeros((10, N_AXES)))
     g92: np.ndarray = field(default_factory=_zeros)
     tool_offset: np.ndarray = field(default_factory=_zeros)  # G43 tool length offset
-    # LinuxCNC keeps the program position when the tool offset changes: the
-    # machine reaches the new offset on the next move.  Until then the program
-    # position differs from position - offset by this much.
+    # rs274 keeps the program position when the tool offset changes in an M6
+    # block: the machine reaches the new offset on the next move.  Until then
+    # the program position differs from position - offset by this much.
     program_shift: np.ndarray = field(default_factory=_zeros)
     g92_saved: np.ndarray | None = None
     home: np.ndarray = field(default_factory=_zeros)  # G28 stored position

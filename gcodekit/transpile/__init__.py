@@ -7,7 +7,8 @@ with canned cycles):
 0. subprograms, loops and macros expanded (the program as it runs);
 1. lengths in the machine's units (G20/G21 gone);
 2. work offsets, G92, G52 and tool-length offsets applied (machine coordinates);
-3. polar words turned into X and Y;
+3. polar words (LinuxCNC ``@``/``^``) turned into X and Y; G16 moves go
+   at stage 2 already, since their pole is the program origin the offsets move;
 4. incremental moves written as absolute ones (G90/G91 gone);
 5. cutter compensation applied (moves are written from the compensated
    waypoints from stage 4 on, so G40/G41/G42 already go at stage 4);
@@ -34,6 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..emulate.exporters import format_number
+from ..emulate.machine import polar_mode_rows
 from ..parse.commands import Kind
 from ..parse.table import CYCLE_NAMES, MOTION_CYCLE, NAMES
 
@@ -48,6 +50,7 @@ _OFFSETS = {"work_offset_%d" % k for k in range(1, 10)} | {
 _DISTANCE = {"distance_absolute", "distance_incremental", "arc_distance_absolute", "arc_distance_incremental"}
 _CYCLE_MODES = {"cancel_cycle", "retract_initial", "retract_r"}
 _COMP = {"cutter_comp_off", "cutter_comp_left", "cutter_comp_right"}
+_POLAR = {"polar_on", "polar_off"}
 #: What the last stage keeps besides motion: dwell, tools, spindle, coolant.
 _KEPT = {"dwell", "tool_change", "spindle_cw", "spindle_ccw", "spindle_off", "coolant_mist", "coolant_flood",
          "coolant_off"}
@@ -80,6 +83,10 @@ class Transpiler:
         # the plane is modal for whoever reads the output: name it on every arc
         # once the program has an arc outside XY
         self._plane_words = bool(np.any(np.asarray(w["plane"])[arcs] != 17))
+        self._polar_rows = polar_mode_rows(self.op.table)  # G16: X radius, Y angle
+        flavor = self.op.flavor
+        #: mm per output length unit from stage 1 on: the machine's own units
+        self.unit = 25.4 if flavor is not None and flavor.units == "inch" else 1.0
 
     # -- public -----------------------------------------------------------------
 
@@ -90,7 +97,8 @@ class Transpiler:
 
             raise ConfigError(f"stage must be one of 0-6, not {k!r}")
         frame = "absolute machine coordinates" if k >= 4 else "machine coordinates" if k >= 2 else "program coordinates"
-        lines = [f"(gcodekit transpile stage {k}: machine units mm, {frame})" if k >= 1 else
+        unit_name = "inch" if self.unit == 25.4 else "mm"
+        lines = [f"(gcodekit transpile stage {k}: machine units {unit_name}, {frame})" if k >= 1 else
                  "(gcodekit transpile stage 0: subprograms, loops and macros expanded)"]
         for row in range(len(self.op.table)):
             lines.extend(self._row(row, k))
@@ -124,10 +132,12 @@ class Transpiler:
             return [f"({_paren(cmd.comment or '')})"] if cmd.comment else []
         moving = self._waypoints(row)
         motion_row = moving.size and np.any(self.op.waypoints["motion"][moving] > 0)
-        if motion_row and (k >= 4 or (k >= 3 and ("@" in cmd.params or "^" in cmd.params))):
+        polar = "@" in cmd.params or "^" in cmd.params or self._polar_rows[row]
+        polar_stage = 2 if self._polar_rows[row] else 3
+        if motion_row and (k >= 4 or (polar and k >= polar_stage)):
             return self._from_waypoints(row, k, moving, comment)
         if (k >= 1 and name in _UNITS) or (k >= 2 and name in _OFFSETS) or (k >= 4 and name in _DISTANCE) \
-                or (k >= 4 and name in _COMP) or (k >= 6 and name in _CYCLE_MODES):
+                or (k >= 2 and name in _POLAR) or (k >= 4 and name in _COMP) or (k >= 6 and name in _CYCLE_MODES):
             return [f"({n} {_paren(str(cmd))} resolved)"] if k < 6 else []
         if k >= 6 and not motion_row and name not in _KEPT and kind not in (Kind.FEED_RATE, Kind.MILL):
             return [f"(dropped: {n} {_paren(str(cmd))})"]
@@ -146,39 +156,51 @@ class Transpiler:
         """The command's own words, with units (stage 1+) and offsets (2+) resolved."""
         w = self.op.waypoints
         wp = self._waypoints(row)[-1]
-        scale = 25.4 if (k >= 1 and w["units"][wp] == 1) else 1.0
-        offset = self._offset(row) if k >= 2 else np.zeros(6)
+        scale = (25.4 if w["units"][wp] == 1 else 1.0) / self.unit if k >= 1 else 1.0
+        offset = self._offset(row) / self.unit if k >= 2 else np.zeros(6)
         absolute = not self._incremental(row)
         words = [cmd.code] if cmd.code and not cmd.code.startswith(("#", "@")) else []
         for letter, value in cmd.params.items():
             if letter in "@^" and k >= 3:
                 continue
-            v = value * scale if letter in _LENGTH_WORDS or letter == "F" else value
+            angle = letter == "Y" and self._polar_rows[row]  # G16: Y is an angle in degrees
+            v = value * scale if (letter in _LENGTH_WORDS or letter == "F") and not angle else value
             if absolute and letter in "XYZ" and k >= 2:
                 v += offset["XYZ".index(letter)]
             words.append(f"{letter}{format_number(v, self.precision)}")
         return " ".join(words + ([cmd.text] if cmd.text else []))
 
     def _from_waypoints(self, row: int, k: int, points: np.ndarray, comment: str) -> list[str]:
-        """Absolute machine-frame moves of a command (stages 4-6; 3 for polar words)."""
+        """Machine-frame moves of a command (stages 4-6; 2-3 for polar moves).
+
+        Before stage 4 G91 may still be in force: the moves are then written
+        as increments from the point before.
+        """
         t, w = self.op.table, self.op.waypoints
         n = f"N{int(t.line[row])}"
         cycle = int(t.motion[row]) == MOTION_CYCLE or NAMES[int(t.name[row])] in CYCLE_NAMES
         if cycle and k < 6:
             return [f"{n} {self._words(row, t.command(row), k)}{comment}"]
         fmt = lambda v: format_number(v, self.precision)  # noqa: E731
+        increments = k < 4 and self._incremental(row)
+
+        def value(axis: str, p: int) -> float:
+            column = w[axis.lower()]
+            v = column[p] - (column[p - 1] if p > 0 else 0.0) if increments else column[p]
+            return v / self.unit if axis in "XYZ" else v
+
         lines = []
         for p in points:
             motion = int(w["motion"][p])
             if motion == 0:
                 continue
-            xyz = " ".join(f"{a}{fmt(w[a.lower()][p])}" for a in "XYZ")
-            abc = " ".join(f"{a}{fmt(w[a.lower()][p])}" for a in "ABC" if np.any(np.asarray(w[a.lower()]) != 0))
+            xyz = " ".join(f"{a}{fmt(value(a, p))}" for a in "XYZ")
+            abc = " ".join(f"{a}{fmt(value(a, p))}" for a in "ABC" if np.any(np.asarray(w[a.lower()]) != 0))
             coords = f"{xyz} {abc}".rstrip()
             if motion == 1:
                 lines.append(f"{n} G0 {coords}")
                 continue
-            feed = f" F{fmt(w['feed'][p])}" if np.isfinite(w["feed"][p]) else ""
+            feed = f" F{fmt(w['feed'][p] / self.unit)}" if np.isfinite(w["feed"][p]) else ""
             if motion == 2:
                 lines.append(f"{n} G1 {coords}{feed}")
             else:
@@ -196,7 +218,7 @@ class Transpiler:
         plane = int(w["plane"][p])
         start = np.array([w[a][p - 1] if p > 0 else 0.0 for a in "xyz"])
         center = np.array([w["cx"][p], w["cy"][p], w["cz"][p]])
-        offsets = np.nan_to_num(center - start)
+        offsets = np.nan_to_num(center - start) / self.unit
         words = " ".join(f"{letter}{format_number(offsets[i], self.precision)}"
                          for i, letter in enumerate("IJK") if not np.isnan(center[i]))
         code = "G2" if motion == 3 else "G3"
