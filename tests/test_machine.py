@@ -353,3 +353,12 @@ def test_g16_refuses_arcs():
     op = gcodekit.gcode_to_operation("G21 G91 G16\nG02 X10 Y10 I5 J0\n", "ger", plan=False)
     assert [(d.line, d.severity) for d in op.diagnostics] == [(2, "error")]
     assert "G16" in op.diagnostics.items[0].message
+
+
+def test_tapping_and_boring_cycles_by_hand():
+    # G84 feeds out to the clear height; G88 stays at the bottom (manual retract)
+    text = "G21 G90 G0 X0 Y0 Z10\nG98 G84 X5 Y0 Z-4 R2 F100\nG80\nG0 Z10\nG88 X8 Z-3 R1 P2\nG80\n"
+    m = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False).motions()
+    assert m[["motion", "x", "z"]].values.tolist() == [
+        ["rapid", 0, 10], ["rapid", 5, 10], ["rapid", 5, 2], ["feed", 5, -4], ["feed", 5, 10],
+        ["rapid", 5, 10], ["rapid", 8, 10], ["rapid", 8, 1], ["feed", 8, -3]]

@@ -1,4 +1,4 @@
-"""Emulate stage: canned cycles (G73, G81-G83, G85, G86, G89) as plain moves.
+"""Emulate stage: canned cycles (G73, G81-G89) as plain moves.
 
 Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
 
@@ -13,6 +13,10 @@ Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
   hole: rapid over the hole (even when already there), rapid down to R if
   above it, the cycle's own moves, then a rapid retract to the clear height: the Z before the block (G98, if that is
   above R) or R (G99).
+* G84 feeds out again (the spindle reversed); G88 stops at the bottom for a
+  manual retract, so the cycle itself never leaves the hole; G87 steps aside
+  by I/J, drops below the part, bores up to K (G91: K from Z) and back, then
+  leaves the way it came.
 * G83 pecks Q deeper each time, rapids back to R, then rapids back down to
   ``delta`` above the last depth; G73 only backs off by ``delta``.  LinuxCNC's
   ``delta`` is 0.010 in (0.254 mm).
@@ -27,11 +31,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..parse.table import MOTION_LINEAR, MOTION_RAPID
+from ..parse.table import CYCLE_NAMES, MOTION_LINEAR, MOTION_RAPID
 from .arcs import PLANES
 
-CYCLES = frozenset({"cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
-                    "cycle_bore_stop", "cycle_bore_dwell"})
+CYCLES = frozenset(CYCLE_NAMES)
 PECK_DELTA_MM = 0.254  # LinuxCNC's G73/G83 back-off and approach, 0.010 in
 
 
@@ -54,6 +57,8 @@ class CycleState:
     z: float | None = None
     p: float = 0.0
     q: float | None = None
+    shift: np.ndarray | None = None  # G87: I/J, the side step off the hole centre (mm)
+    k: float | None = None  # G87: the level the back bore reaches (program mm)
     retract_to_r: bool = False  # G99
 
 
@@ -80,6 +85,8 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
         cycle.p = params["P"] * dwell_unit
     if "Q" in params:
         cycle.q = params["Q"] * scale[axis]
+    if cycle.name == "cycle_back_bore":
+        _back_bore_words(cycle, params, plane, scale)
     if cycle.r is None or cycle.z is None:
         raise ValueError(f"canned cycle needs R and {letter} (none in force)")
     repeats = int(params.get("L", 1))
@@ -103,6 +110,10 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
         here[axis] = coord + to_machine
         steps.append(Step(here.copy(), motion, dwell))
 
+    def slide(aside: bool) -> None:  # G87: rapid to the side step off the hole centre, or back
+        here[[a, b]] = target[[a, b]] + offset[[a, b]] + (cycle.shift if aside else 0.0)
+        steps.append(Step(here.copy(), MOTION_RAPID))
+
     if below_r:  # preliminary move up to the R plane
         go(r, MOTION_RAPID)
     target = program.copy()
@@ -116,8 +127,37 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
         steps.append(Step(here.copy(), MOTION_RAPID))
         if here[axis] != r + to_machine:
             go(r, MOTION_RAPID)
-        _drill(cycle, r, bottom, clear, go)
+        if cycle.name == "cycle_back_bore":
+            _back_bore(bottom + cycle.k if incremental else cycle.k, bottom, clear, go, slide)  # G91: K from Z
+        else:
+            _drill(cycle, r, bottom, clear, go)
     return steps
+
+
+def _back_bore_words(cycle: CycleState, params: dict, plane: int, scale: np.ndarray) -> None:
+    """G87's I/J side step (in the plane's two axes) and K level, kept while the cycle lasts."""
+    (a, b, axis), letters = PLANES[plane]
+    offset_letters = {0: "I", 1: "J", 2: "K"}
+    first, second, level = offset_letters[a], offset_letters[b], offset_letters[axis]
+    if first in params or second in params or cycle.shift is None:
+        cycle.shift = np.array([params.get(first, 0.0) * scale[a], params.get(second, 0.0) * scale[b]])
+    if level in params:
+        cycle.k = params[level] * scale[axis]
+    if cycle.k is None:
+        raise ValueError(f"G87 needs {level}, the level to back-bore to")
+
+
+def _back_bore(level: float, bottom: float, clear: float, go, slide) -> None:
+    """G87 (LinuxCNC): step aside at R, drop below the part, centre, bore up to
+    the K level and back, step aside again, rise to the clear height, centre."""
+    slide(True)
+    go(bottom, MOTION_RAPID)
+    slide(False)
+    go(level, MOTION_LINEAR)
+    go(bottom, MOTION_LINEAR)
+    slide(True)
+    go(clear, MOTION_RAPID)
+    slide(False)
 
 
 def polar_target(params: dict, xy: np.ndarray, scale: float, incremental: bool) -> np.ndarray:
@@ -145,6 +185,11 @@ def _drill(cycle: CycleState, r: float, bottom: float, clear: float, go) -> None
             if depth > bottom:
                 go(r if name == "cycle_peck" else depth + PECK_DELTA_MM, MOTION_RAPID)
         go(clear, MOTION_RAPID)
+    elif name == "cycle_tap":  # G84: the spindle reverses at the bottom; out at feed to the clear height
+        go(bottom, MOTION_LINEAR)
+        go(clear, MOTION_LINEAR)
+    elif name == "cycle_bore_manual":  # G88: the operator retracts by hand after the program stop
+        go(bottom, MOTION_LINEAR, cycle.p)
     elif name in ("cycle_bore", "cycle_bore_dwell"):
         go(bottom, MOTION_LINEAR, cycle.p if name == "cycle_bore_dwell" else 0.0)
         go(r, MOTION_LINEAR)

@@ -18,7 +18,9 @@ Usage::
     python tests/golden/linuxcnc/regenerate.py [--corpus DIR] [--rerun]
 
 ``--rerun`` re-runs ``/usr/bin/rs274`` on every case first (the corpus
-``.canon.csv`` files are used otherwise).  Writes ``manifest.tsv`` and
+``.canon.csv`` files are used otherwise).  Programs in ``own/`` (ours, for
+features the corpus lacks) are always cases; ``--rerun`` refreshes their
+``.canon.csv`` too.  Writes ``manifest.tsv`` and
 ``cases/``.
 """
 
@@ -36,6 +38,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 CASES = HERE / "cases"
+OWN = HERE / "own"  # programs we wrote for what the corpus lacks, with rs274's output
 TABLES = Path(__file__).parent / "tooltables"
 MANIFEST = HERE / "manifest.tsv"
 SHARED = HERE.parents[3] / "shared"
@@ -74,7 +77,7 @@ KNOWN_GAPS = {
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
 EXCLUDED_G = {
     **dict.fromkeys(("41.1", "42.1"), "dynamic cutter compensation"),
-    **dict.fromkeys(("74", "76", "84", "87", "88"), "canned cycle not emulated yet"),
+    **dict.fromkeys(("74", "76"), "canned cycle not emulated yet"),
     **dict.fromkeys(("33", "33.1"), "threading"),
     **dict.fromkeys(("38.2", "38.3", "38.4", "38.5"), "probing"),
     **dict.fromkeys(("5", "5.1", "5.2", "5.3"), "spline"),
@@ -166,7 +169,8 @@ def rerun(program: Path, table: Path | None, canon: Path) -> None:
     cmd = [str(TOOLS / "run_rs274.sh"), str(program)] + ([str(table)] if table else [])
     with canon.open("w") as f:
         subprocess.run(cmd, stdout=f, check=True)
-    cmd = [sys.executable, str(TOOLS / "canon_to_csv.py"), str(canon), "-o", f"{canon}.csv",
+    python = "/usr/bin/python3" if Path("/usr/bin/python3").exists() else sys.executable  # has LinuxCNC's gcode
+    cmd = [python, str(TOOLS / "canon_to_csv.py"), str(canon), "-o", f"{canon}.csv",
            "--src", str(program)] + (["--tbl", str(table)] if table else [])
     subprocess.run(cmd, check=True)
 
@@ -237,6 +241,13 @@ def main(argv: list[str] | None = None) -> int:
             expected = fresh if args.rerun else corpus / (program + ".canon.csv")
             shutil.copyfile(corpus / program, CASES / name)
             shutil.copyfile(expected, CASES / (name + ".canon.csv"))
+        for program in sorted(OWN.glob("*.ngc")):
+            if args.rerun:
+                rerun(program, None, Path(tmp) / (program.name + ".canon"))
+                shutil.copyfile(Path(tmp) / (program.name + ".canon.csv"), OWN / (program.name + ".canon.csv"))
+            shutil.copyfile(program, CASES / ("own__" + program.name))
+            shutil.copyfile(OWN / (program.name + ".canon.csv"), CASES / ("own__" + program.name + ".canon.csv"))
+            chosen.append(f"own/{program.name}")
     # the tool tables rs274 ran with (inches), and which case used which
     TABLES.mkdir(exist_ok=True)
     for table in (corpus / "tooltables").glob("*.tbl"):
@@ -247,7 +258,8 @@ def main(argv: list[str] | None = None) -> int:
         w.writerow(["program", "motions", "golden", "reason"])
         for e in sorted(entries, key=lambda e: (not e.golden, e.program)):
             w.writerow([e.program, e.motions, "yes" if e.golden else "no", e.reason])
-    print(f"{len(chosen)} of {len(entries)} programs are golden cases ({REFERENCE})")
+    own = sum(program.startswith("own/") for program in chosen)
+    print(f"{len(chosen) - own} of {len(entries)} corpus programs and {own} of our own are golden cases ({REFERENCE})")
     return 0
 
 
