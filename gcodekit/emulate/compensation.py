@@ -30,12 +30,14 @@ from .arcs import PLANES, arc_length, sweep
 if TYPE_CHECKING:
     from .operation import Operation
 
-_SIDES = {NAME_ID["cutter_comp_left"]: 1, NAME_ID["cutter_comp_right"]: -1, NAME_ID["cutter_comp_off"]: 0}
+_SIDES = {NAME_ID["cutter_comp_left"]: 1, NAME_ID["cutter_comp_right"]: -1, NAME_ID["cutter_comp_off"]: 0,
+          NAME_ID["cutter_comp_left_dynamic"]: 1, NAME_ID["cutter_comp_right_dynamic"]: -1}
+_DYNAMIC = {NAME_ID["cutter_comp_left_dynamic"], NAME_ID["cutter_comp_right_dynamic"]}  # G41.1/G42.1: D is a diameter
 _TINY = 1e-9
 
 
 def uses_compensation(op: "Operation") -> bool:
-    return bool(np.isin(op.table.name, list(_SIDES)[:2]).any())
+    return bool(np.isin(op.table.name, [k for k, side in _SIDES.items() if side]).any())
 
 
 def compensate(op: "Operation", tools) -> None:
@@ -69,8 +71,11 @@ def compensate(op: "Operation", tools) -> None:
                     if new and not side:
                         side, mode = new, "entry"
                         params = t.command(r).params
-                        number = int(params.get("D", columns["tool"][k]))
-                        radius = tools[number].diameter / 2.0 if number in tools else 0.0
+                        if int(t.name[r]) in _DYNAMIC:
+                            radius = params.get("D", 0.0) * (25.4 if columns["units"][k] == 1 else 1.0) / 2.0
+                        else:
+                            number = int(params.get("D", columns["tool"][k]))
+                            radius = tools[number].diameter / 2.0 if number in tools else 0.0
                     elif not new and side:
                         side, mode = 0, "exit"
             current_row = row

@@ -41,6 +41,7 @@ _RANK = {
     "dwell": 14, "plane_xy": 15, "plane_zx": 15, "plane_yz": 15,
     "units_inch": 16, "units_mm": 16,
     "cutter_comp_off": 17, "cutter_comp_left": 17, "cutter_comp_right": 17,
+    "cutter_comp_left_dynamic": 17, "cutter_comp_right_dynamic": 17,
     "tool_length_offset": 18, "tool_length_offset_dynamic": 18, "tool_length_offset_add": 18,
     "cancel_tool_length": 18,
     **{f"work_offset_{k}": 19 for k in range(1, 10)},
@@ -162,9 +163,12 @@ def _split_modal(words, flavor):
     if consumer is None and (has_axes or "E" in rest):
         consumer = Part("")  # a move in the modal motion mode
         ordered.insert(_insert_at(ordered, flavor, 24), consumer)
-    special = {"P": ("dwell", "coordinate_data"), "L": ("coordinate_data",),
+    special = {"P": ("dwell", "coordinate_data"),
                "H": ("tool_length_offset", "tool_length_offset_add"),
-               "D": ("cutter_comp_left", "cutter_comp_right"), "T": ("tool_change",),
+               "D": ("cutter_comp_left", "cutter_comp_right", "cutter_comp_left_dynamic",
+                     "cutter_comp_right_dynamic"),
+               "L": ("coordinate_data", "cutter_comp_left_dynamic", "cutter_comp_right_dynamic"),
+               "T": ("tool_change",),
                "S": ("spindle_cw", "spindle_ccw")}
     for letter in list(rest):
         owner = next((by_name[n] for n in special.get(letter, ()) if n in by_name), None)

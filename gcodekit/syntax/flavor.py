@@ -38,7 +38,7 @@ COMMANDS = frozenset(
     program_stop optional_stop program_end
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
     coordinate_data local_offset polar_on polar_off
-    cutter_comp_off cutter_comp_left cutter_comp_right
+    cutter_comp_off cutter_comp_left cutter_comp_right cutter_comp_left_dynamic cutter_comp_right_dynamic
     cancel_cycle exact_stop path_blending retract_initial retract_r
     cycle_drill cycle_drill_dwell cycle_peck cycle_chip_break cycle_bore cycle_bore_stop cycle_bore_dwell
     cycle_tap cycle_back_bore cycle_bore_manual

@@ -49,7 +49,8 @@ _OFFSETS = {"work_offset_%d" % k for k in range(1, 10)} | {
     "tool_length_offset_add", "cancel_tool_length"}
 _DISTANCE = {"distance_absolute", "distance_incremental", "arc_distance_absolute", "arc_distance_incremental"}
 _CYCLE_MODES = {"cancel_cycle", "retract_initial", "retract_r"}
-_COMP = {"cutter_comp_off", "cutter_comp_left", "cutter_comp_right"}
+_COMP = {"cutter_comp_off", "cutter_comp_left", "cutter_comp_right", "cutter_comp_left_dynamic",
+         "cutter_comp_right_dynamic"}
 _POLAR = {"polar_on", "polar_off"}
 #: What the last stage keeps besides motion: dwell, tools, spindle, coolant.
 _KEPT = {"dwell", "tool_change", "spindle_cw", "spindle_ccw", "spindle_off", "coolant_mist", "coolant_flood",

@@ -76,7 +76,6 @@ KNOWN_GAPS = {
 
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
 EXCLUDED_G = {
-    **dict.fromkeys(("41.1", "42.1"), "dynamic cutter compensation"),
     **dict.fromkeys(("74", "76"), "canned cycle not emulated yet"),
     **dict.fromkeys(("33", "33.1"), "threading"),
     **dict.fromkeys(("38.2", "38.3", "38.4", "38.5"), "probing"),
