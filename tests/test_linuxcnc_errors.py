@@ -18,7 +18,6 @@ import gcodekit
 from gcodekit.errors import GcodeError
 
 ERRORS = Path(__file__).parent / "golden" / "linuxcnc" / "errors"
-TOOL_TABLE = ERRORS.parent / "tooltables" / "tool.tbl"
 
 
 def _cases() -> list[tuple[str, int, str, str]]:
@@ -30,7 +29,9 @@ CASES = _cases()
 
 
 def _run(name: str, mode: str):
-    return gcodekit.gcode_to_operation(ERRORS / name, "linuxcnc", plan=False, mode=mode, tool_table=TOOL_TABLE,
+    from test_linuxcnc_golden import tool_table  # the table rs274 ran the program with
+
+    return gcodekit.gcode_to_operation(ERRORS / name, "linuxcnc", plan=False, mode=mode, tool_table=tool_table(name),
                                        tool_table_units="inch")  # rs274 standalone reads tables in inches
 
 

@@ -96,7 +96,8 @@ def tool_table(name: str) -> Path:
     tables = CASES.parent / "tooltables"
     for line in (tables / "overrides.tsv").read_text().splitlines():
         program, _, table = line.partition("\t")
-        if not line.startswith("#") and Path(program).name == name:
+        flat = program.removeprefix("nc_files/").replace("/", "__")  # case files are named flat
+        if not line.startswith("#") and name in (flat, Path(program).name):
             return tables / Path(table).name
     return tables / "tool.tbl"
 

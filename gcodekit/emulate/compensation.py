@@ -56,6 +56,7 @@ def compensate(op: "Operation", tools) -> None:
     pending = None  # index in `out` of the previous compensated waypoint
     side_rows = {int(r): _SIDES[int(t.name[r])] for r in np.flatnonzero(np.isin(t.name, list(_SIDES)))}
     current_row = -1
+    entry_row = -1  # the command whose entry length was refused
 
     def emit(k: int, **changes) -> int:
         for key in columns:
@@ -97,6 +98,11 @@ def compensate(op: "Operation", tools) -> None:
             mode, last_dir, last_corner, pending, last_path = "off", None, None, None, None
             continue
         chord = end - programmed_start
+        if mode == "entry" and entry_row != row and motion < MOTION_CW and np.hypot(*(end - start)) <= radius \
+                and not _leaves_plane(columns, k, f, g):
+            entry_row = row  # once per command
+            op.diagnostics.report(int(t.line[row]), 1, "Length of cutter compensation entry move is not "
+                                  "greater than the tool radius", kind="machine")
         if np.hypot(*chord) < _TINY and motion < MOTION_CW:  # a move along the plane's normal keeps the offset
             emit(k, **{a: start[0], b: start[1]})
             continue
@@ -106,6 +112,11 @@ def compensate(op: "Operation", tools) -> None:
             r0 = np.hypot(*(programmed_start - center))
             r1 = np.hypot(*(end - center))
             grow = -side if ccw else side  # G41 on a CCW arc is inside it
+            if grow < 0 and r1 <= radius + _TINY:
+                op.diagnostics.report(int(t.line[row]), 1, "Tool radius not less than arc radius with comp",
+                                      kind="machine")
+                emit(k)
+                continue
             new_r1 = r1 + grow * radius
             in_dir = _unit(np.array([-(programmed_start - center)[1], (programmed_start - center)[0]]) * (1 if ccw else -1))
             out_dir = _unit(np.array([-(end - center)[1], (end - center)[0]]) * (1 if ccw else -1))
@@ -154,6 +165,13 @@ def compensate(op: "Operation", tools) -> None:
     for key in columns:
         w[key] = np.asarray(out[key], dtype=columns[key].dtype)
     _recompute_lengths(w)
+
+
+def _leaves_plane(columns: dict, k: int, f: int, g: int) -> bool:
+    """Whether waypoint ``k`` moves along the plane's normal (a plunge, not an entry)."""
+    h = 3 - f - g
+    axis = "xyz"[h]
+    return k > 0 and abs(columns[axis][k] - columns[axis][k - 1]) > _TINY
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
