@@ -222,11 +222,7 @@ class ModalHandler:
             radius = params["X"] * scale[0] if "X" in params else float(np.hypot(*program[[0, 1]]))
             angle = np.radians(params["Y"]) if "Y" in params else float(np.arctan2(program[1], program[0]))
             program[[0, 1]] = radius * np.array([np.cos(angle), np.sin(angle)])
-        for ax, letter in enumerate(AXES):
-            if letter in params and letter not in "XY":
-                program[ax] = program[ax] + params[letter] * scale[ax] if s.incremental else params[letter] * scale[ax]
-        s.position = program + s.offset
-        s.program_shift[:] = 0.0
+        self._move_to(program, params)
         return motion
 
     def _polar_move(self, params: dict, motion: int, line: int) -> int:
@@ -238,12 +234,18 @@ class ModalHandler:
         program = s.program_position()
         scale = s.scale()
         program[[0, 1]] = polar_target(params, program[[0, 1]], scale[0], s.incremental)
+        self._move_to(program, params)
+        return motion
+
+    def _move_to(self, program: np.ndarray, params: dict) -> None:
+        """Finish a move whose X/Y the caller worked out: other axes from their words."""
+        s = self.state
+        scale = s.scale()
         for ax, letter in enumerate(AXES):
             if letter in params and letter not in "XY":
                 program[ax] = program[ax] + params[letter] * scale[ax] if s.incremental else params[letter] * scale[ax]
         s.position = program + s.offset
         s.program_shift[:] = 0.0
-        return motion
 
     def _coordinate_data(self, params: dict, line: int) -> None:
         """G10: L2/L20 set a work offset, L1/L10/L11 a tool's offsets (LinuxCNC 2.9)."""

@@ -7,11 +7,11 @@ run headless by ``../shared/tools/linuxcnc/run_rs274.sh`` and tabulated by
 
 A program qualifies when ``RESULTS.tsv`` marks it ``ok``, it has motions, all
 of them matched to a source line (``line_match`` ok, or ``order`` for moves
-rs274 emitted late), no rotary-axis work or G92 offset is active (the CSV only carries X/Y/Z offsets), and its text
-(comments stripped) uses only the foundation features: no O-words or
-subprograms, cutter compensation, canned or lathe cycles, threading, probing,
-splines, lathe modes, I/O M-codes,
-user or unknown codes, or system parameters.
+rs274 emitted late), no rotary-axis work or G92 offset is active (the CSV
+only carries X/Y/Z offsets), its text (comments stripped) uses no feature
+gcodekit does not emulate yet (:data:`EXCLUDED_G`: lathe and threading
+cycles, G74/G76, probing, splines, lathe modes; I/O M-codes, user or unknown
+codes, system parameters), and it is not a :data:`KNOWN_GAPS` program.
 
 Usage::
 
