@@ -1,4 +1,4 @@
-"""Emulate stage: canned cycles (G73, G81-G89) as plain moves.
+"""Emulate stage: canned cycles (G73, G74, G81-G89) as plain moves.
 
 Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
 
@@ -13,7 +13,7 @@ Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
   hole: rapid over the hole (even when already there), rapid down to R if
   above it, the cycle's own moves, then a rapid retract to the clear height: the Z before the block (G98, if that is
   above R) or R (G99).
-* G84 feeds out again (the spindle reversed); G88 stops at the bottom for a
+* G84 and G74 feed out again (the spindle reversed); G88 stops at the bottom for a
   manual retract, so the cycle itself never leaves the hole; G87 steps aside
   by I/J, drops below the part, bores up to K (G91: K from Z) and back, then
   leaves the way it came.
@@ -185,7 +185,7 @@ def _drill(cycle: CycleState, r: float, bottom: float, clear: float, go) -> None
             if depth > bottom:
                 go(r if name == "cycle_peck" else depth + PECK_DELTA_MM, MOTION_RAPID)
         go(clear, MOTION_RAPID)
-    elif name == "cycle_tap":  # G84: the spindle reverses at the bottom; out at feed to the clear height
+    elif name in ("cycle_tap", "cycle_tap_left"):  # G84/G74: spindle reversed at the bottom, out at feed
         go(bottom, MOTION_LINEAR)
         go(clear, MOTION_LINEAR)
     elif name == "cycle_bore_manual":  # G88: the operator retracts by hand after the program stop

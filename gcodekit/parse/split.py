@@ -24,7 +24,8 @@ from ..syntax.flavor import code_label
 
 AXIS_LETTERS = frozenset("XYZABCUVW@^")  # @ and ^: LinuxCNC's polar X/Y
 CYCLES = frozenset({"cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
-                    "cycle_bore_stop", "cycle_bore_dwell", "cycle_tap", "cycle_back_bore", "cycle_bore_manual"})
+                    "cycle_bore_stop", "cycle_bore_dwell", "cycle_tap", "cycle_tap_left", "cycle_back_bore",
+                    "cycle_bore_manual"})
 #: Commands that take axis words in the same block.
 AXIS_CONSUMERS = frozenset(
     {"rapid", "linear", "arc_cw", "arc_ccw", "set_position", "home", "home_secondary",

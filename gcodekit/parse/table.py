@@ -24,7 +24,8 @@ MOTION_NAMES = ("", "rapid", "feed", "arc_cw", "arc_ccw")
 MOTION_OF_NAME = {"rapid": MOTION_RAPID, "linear": MOTION_LINEAR, "arc_cw": MOTION_CW, "arc_ccw": MOTION_CCW}
 #: Canned cycles: the command table's motion is MOTION_CYCLE (never a waypoint's)
 CYCLE_NAMES = ("cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
-               "cycle_bore_stop", "cycle_bore_dwell", "cycle_tap", "cycle_back_bore", "cycle_bore_manual")
+               "cycle_bore_stop", "cycle_bore_dwell", "cycle_tap", "cycle_tap_left", "cycle_back_bore",
+               "cycle_bore_manual")
 
 _SPARSE_BELOW = 0.02  # a parameter present in fewer rows than this is kept sparse
 

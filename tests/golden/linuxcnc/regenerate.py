@@ -76,7 +76,7 @@ KNOWN_GAPS = {
 
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
 EXCLUDED_G = {
-    **dict.fromkeys(("74", "76"), "canned cycle not emulated yet"),
+    "76": "threading cycle not emulated yet",
     **dict.fromkeys(("33", "33.1"), "threading"),
     **dict.fromkeys(("38.2", "38.3", "38.4", "38.5"), "probing"),
     **dict.fromkeys(("5", "5.1", "5.2", "5.3"), "spline"),
