@@ -70,3 +70,24 @@ def test_arc_radius_grows_on_the_outside(tool_table):
     assert last["motion"] == "arc_ccw"
     assert (last["x"], last["y"]) == pytest.approx((-6, 0))
     assert (last["cx"], last["cy"]) == pytest.approx((0, 0))
+
+
+# Gouge checks: programs and messages checked with LinuxCNC 2.9's rs274
+# (tool 4 of tooltables/simpockets.tbl, 3/8" diameter), which refuses both on line 6.
+GOUGE_CASES = {
+    "step_shorter_than_radius": ("G20 G17 G90 T4 M6\nG0 X-1 Y0 Z0\nG41 G1 X0 Y0 F10\nX2\nY0.1\nX4\nY-1\nM2\n",
+                                 "Straight feed in concave corner cannot be reached by the tool without gouging"),
+    "arc_smaller_than_tool": ("G20 G17 G90 T4 M6\nG0 X-1 Y0 Z0\nG41 G1 X0 Y0 F10\nX2\nG3 X2.2 Y0.2 I0 J0.2\n"
+                              "G1 X0.5\nY-1\nM2\n",
+                              "Arc to straight motion makes a corner the compensated tool can't fit in without gouging"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(GOUGE_CASES))
+def test_gouging_is_refused_on_rs274s_line(name):
+    from pathlib import Path
+
+    text, message = GOUGE_CASES[name]
+    table = Path(__file__).parent / "golden" / "linuxcnc" / "tooltables" / "simpockets.tbl"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, tool_table=table, tool_table_units="inch")
+    assert [(d.line, d.message) for d in op.diagnostics if d.severity == "error"] == [(6, message)]

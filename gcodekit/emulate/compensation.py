@@ -11,7 +11,9 @@ tool off it by the tool radius, after the rules of LinuxCNC's interpreter
   by the tool radius); at an outside corner the tool rolls round the
   programmed corner on an arc of the tool radius, at an inside corner the
   previous move is cut short where the two shifted paths meet;
-* the first move after G40 (the exit) runs straight to its programmed end.
+* the first move after G40 (the exit) runs straight to its programmed end;
+* gouges are errors, as in rs274: an offset line that would run backwards
+  between its corners, or an inside corner whose offset paths never meet.
 
 Runs once over the emulated waypoints of programs that use G41/G42; it is a
 per-move Python loop because each corner depends on the move before.
@@ -54,6 +56,7 @@ def compensate(op: "Operation", tools) -> None:
     last_path = None  # its offset path: ("line", point, direction) or ("arc", centre, radius)
     last_corner = None  # programmed end of the previous move
     pending = None  # index in `out` of the previous compensated waypoint
+    pending_start, pending_dir = None, None  # where it starts and, for a line, its programmed direction
     side_rows = {int(r): _SIDES[int(t.name[r])] for r in np.flatnonzero(np.isin(t.name, list(_SIDES)))}
     current_row = -1
     entry_row = -1  # the command whose entry length was refused
@@ -96,6 +99,7 @@ def compensate(op: "Operation", tools) -> None:
         if mode == "exit":
             emit(k)  # straight from the compensated point to the programmed end
             mode, last_dir, last_corner, pending, last_path = "off", None, None, None, None
+            pending_start, pending_dir = None, None
             continue
         chord = end - programmed_start
         if mode == "entry" and entry_row != row and motion < MOTION_CW and np.hypot(*(end - start)) <= radius \
@@ -133,6 +137,7 @@ def compensate(op: "Operation", tools) -> None:
             if entry_center is None:
                 entry_center = center
             pending = emit(k, **{a: new_end[0], b: new_end[1], ca: entry_center[0], cb: entry_center[1]})
+            pending_start, pending_dir = start, None
             mode, last_dir, last_corner = "on", out_dir, end
             last_path = ("arc", entry_center, float(np.hypot(*(new_end - entry_center))))
             continue
@@ -140,6 +145,7 @@ def compensate(op: "Operation", tools) -> None:
             # comp1: straight to the end shifted off the entry move's own direction
             shifted = end + _left(_unit(chord)) * side * radius
             pending = emit(k, **{a: shifted[0], b: shifted[1]})
+            pending_start, pending_dir = start, _unit(chord)
             mode, last_dir, last_corner = "on", _unit(chord), end
             last_path = ("line", shifted, _unit(chord))
             continue
@@ -159,8 +165,18 @@ def compensate(op: "Operation", tools) -> None:
                 if meet is not None:
                     out[a][pending], out[b][pending] = meet[0], meet[1]
                     new_start = meet
+                else:
+                    kinds = "Arc" if last_path[0] == "arc" else "Straight", "arc" if this_path[0] == "arc" else "straight"
+                    op.diagnostics.report(int(t.line[row]), 1, f"{kinds[0]} to {kinds[1]} motion makes a corner the "
+                                          "compensated tool can't fit in without gouging", kind="machine")
+        if pending_dir is not None and pending is not None:
+            done = np.array([out[a][pending], out[b][pending]]) - pending_start
+            if float(done @ pending_dir) < -_TINY:  # the offset move would run backwards
+                op.diagnostics.report(int(t.line[row]), 1, "Straight feed in concave corner cannot be reached by "
+                                      "the tool without gouging", kind="machine")
         centre = (columns[ca][k], columns[cb][k]) if motion in (MOTION_CW, MOTION_CCW) else (np.nan, np.nan)
         pending = emit(k, **{a: new_end[0], b: new_end[1], ca: centre[0], cb: centre[1]})
+        pending_start, pending_dir = new_start, (None if motion in (MOTION_CW, MOTION_CCW) else in_dir)
         last_dir, last_corner, last_path = out_dir, end, this_path
     for key in columns:
         w[key] = np.asarray(out[key], dtype=columns[key].dtype)
