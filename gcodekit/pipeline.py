@@ -121,7 +121,8 @@ def emulate_operation(operation: Operation, machine: str | MachineConfig | None 
         machine if isinstance(machine, MachineConfig) else load_machine(machine))
     fl = operation.flavor
     m = Machine(config, operation.diagnostics, rapid_is_feed=fl.rapid_is_feed, initial_units=fl.units,
-                initial_extrusion=fl.extrusion, rs274_blocks=fl.block_split == "modal")
+                initial_extrusion=fl.extrusion, rs274_blocks=fl.block_split == "modal",
+                polar_incremental_only=fl.polar_incremental_only)
     operation.waypoints = m.run(operation.table)
     operation.machine = config
     return operation
@@ -176,7 +177,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     diagnostics = Diagnostics(program.name, mode)
     parser = GcodeParser(fl, diagnostics)
     m = Machine(config, diagnostics, rapid_is_feed=fl.rapid_is_feed, initial_units=fl.units,
-                initial_extrusion=fl.extrusion, rs274_blocks=fl.block_split == "modal")
+                initial_extrusion=fl.extrusion, rs274_blocks=fl.block_split == "modal",
+                polar_incremental_only=fl.polar_incremental_only)
     tables, waypoints, n_lines = [], [], 0
     bar = _progress(program, progress)
     for blocks, lines in _blocks(program, fl, diagnostics, bar):

@@ -362,3 +362,11 @@ def test_tapping_and_boring_cycles_by_hand():
     assert m[["motion", "x", "z"]].values.tolist() == [
         ["rapid", 0, 10], ["rapid", 5, 10], ["rapid", 5, 2], ["feed", 5, -4], ["feed", 5, 10],
         ["rapid", 5, 10], ["rapid", 8, 10], ["rapid", 8, 1], ["feed", 8, -3]]
+
+
+def test_g16_under_ger_rules():
+    # GER: polar moves only in G91, and the program zero stays put while G16 is on
+    op = gcodekit.gcode_to_operation("G21 G90 G16\nG01 X10 Y90 F100\nG91 G92 X5\nG15\n", "ger", plan=False)
+    errors = [(d.line, d.message) for d in op.diagnostics if d.severity == "error"]
+    assert [line for line, _ in errors] == [2, 3]
+    assert "G91" in errors[0][1] and "program zero" in errors[1][1]

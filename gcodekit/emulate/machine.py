@@ -68,11 +68,15 @@ class Machine:
     diagnostics : Diagnostics, default: a new lenient collector
     rapid_is_feed : bool
         G0 moves at the modal feed (from the flavor unless the preset says).
+    rs274_blocks : bool
+        RS274NGC block rules (F in any block; unknown axis letters refused).
+    polar_incremental_only : bool
+        GER's G16 rules: polar moves only in G91, program zero fixed meanwhile.
     """
 
     def __init__(self, config: MachineConfig, diagnostics: Diagnostics | None = None, *,
                  rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = "",
-                 rs274_blocks: bool = False):
+                 rs274_blocks: bool = False, polar_incremental_only: bool = False):
         self.config = config
         self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
         self.rapid_is_feed = config.rapid_is_feed if config.rapid_is_feed is not None else rapid_is_feed
@@ -80,6 +84,7 @@ class Machine:
         # does, and a word for an axis the machine lacks is an error.  Printer
         # firmware reads F only on moves and U/V/W as flags (Prusa's G28 W).
         self.rs274_blocks = rs274_blocks
+        self.polar_incremental_only = polar_incremental_only  # GER's G16 rules
         self.state = MachineState()
         self.state.units = 25.4 if initial_units == "inch" else 1.0
         self.state.e_relative = initial_extrusion == "relative"

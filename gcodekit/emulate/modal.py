@@ -38,6 +38,7 @@ SPECIAL_NAMES = frozenset(
 ) | {f"work_offset_{k}" for k in range(1, 10)}
 
 _MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
+_PROGRAM_ZERO = frozenset({"local_offset", "set_position", "clear_position_offset"})  # G52, G92, G92.1
 _SIMPLE = {
     "units_inch": ("units", 25.4), "units_mm": ("units", 1.0),
     "distance_absolute": ("incremental", False), "distance_incremental": ("incremental", True),
@@ -86,6 +87,10 @@ class ModalHandler:
             units = _SIMPLE[name][1] if name in ("units_inch", "units_mm") else s.units
             s.feed = params["F"] * units
         moves = int(t.kind[row]) in _MOVING_KINDS
+        if s.polar and self.machine.polar_incremental_only and (name in _PROGRAM_ZERO or
+                                                                name.startswith("work_offset_")):
+            self.machine.diagnostics.report(line, 1, "the program zero may not change while polar coordinates (G16) "
+                                            "are on", kind="machine")
         if moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
             motion, extra = self._cycle(name, params, line)
         elif moves and ("@" in params or "^" in params):
@@ -212,6 +217,10 @@ class ModalHandler:
         if motion not in (MOTION_RAPID, MOTION_LINEAR) or s.plane != 17:
             self.machine.diagnostics.report(line, 1, "G16 polar coordinates allow only G0 and G1 in the XY plane",
                                             kind="machine")
+            return MOTION_NONE
+        if self.machine.polar_incremental_only and not s.incremental:
+            self.machine.diagnostics.report(line, 1, "polar coordinates (G16) may only be used in incremental "
+                                            "mode (G91)", kind="machine")
             return MOTION_NONE
         program = s.program_position()
         scale = s.scale()

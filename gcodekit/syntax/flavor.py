@@ -144,6 +144,9 @@ class Flavor:
     polar_words : bool
         ``@`` (distance) and ``^`` (angle, degrees) words give X and Y in polar
         form (LinuxCNC).
+    polar_incremental_only : bool
+        G16 polar moves only in G91, and no change of program zero while
+        G16 is on (GER); otherwise Fanuc's rules (G90: pole at the origin).
     directive_prefix : str
         Lines starting with this text are controller directives kept as
         named commands (Beckhoff ``#TRAFO ON``); ``""`` for none.
@@ -192,6 +195,7 @@ class Flavor:
     code_assignments: bool = False
     directive_prefix: str = ""
     polar_words: bool = False
+    polar_incremental_only: bool = False
     required_axes: str = ""
     words: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     codes: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
