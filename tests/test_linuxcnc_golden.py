@@ -23,7 +23,8 @@ PROGRAMS = sorted(p.name for p in CASES.glob("*.ngc"))
 ATOL, RTOL = 1e-4, 1e-9
 AXES = ["x", "y", "z", "a", "b", "c"]
 CENTRE = ["cx", "cy", "cz"]
-CANON_MOTION = {"STRAIGHT_TRAVERSE": "rapid", "STRAIGHT_FEED": "feed"}
+# rs274 standalone has no probe input: a probe move runs to its target, a feed for us
+CANON_MOTION = {"STRAIGHT_TRAVERSE": "rapid", "STRAIGHT_FEED": "feed", "STRAIGHT_PROBE": "feed"}
 
 
 def to_machine(x: np.ndarray, y: np.ndarray, z: np.ndarray,

@@ -24,7 +24,7 @@ from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
-from .table import CYCLE_NAMES, MOTION_CYCLE, MOTION_NONE, MOTION_OF_NAME, NAME_ID, CommandTable
+from .table import CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_OF_NAME, NAME_ID, CommandTable
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
 _KEEP = 255  # "this row does not set the motion mode"
@@ -32,6 +32,10 @@ _KEEP = 255  # "this row does not set the motion mode"
 PARAM_LETTERS = "ABCDEFGHIJKLMNOPQRSTUVWXYZ@^"
 _LETTER_ROW = np.full(256, -1, np.int64)
 _LETTER_ROW[[ord(c) for c in PARAM_LETTERS]] = np.arange(len(PARAM_LETTERS))
+
+#: Motion modes by command name.  A probe (G38.x) is a straight feed to its
+#: target: without a probe input it never trips, as in rs274 standalone.
+_MOTION_MODES = {**MOTION_OF_NAME, "probe": MOTION_LINEAR}
 
 
 class GcodeParser:
@@ -259,7 +263,7 @@ class GcodeParser:
         self._report_unknown(t, name)
 
         sets = np.full(n, _KEEP, np.uint8)
-        for mname, mode in MOTION_OF_NAME.items():
+        for mname, mode in _MOTION_MODES.items():
             sets[name == NAME_ID[mname]] = mode
         sets[name == NAME_ID["cancel_cycle"]] = MOTION_NONE
         sets[np.isin(name, self._cycle_ids)] = MOTION_CYCLE
@@ -282,7 +286,7 @@ class GcodeParser:
         has_axes, has_e, has_s, has_f = has("XYZABCUVW@^"), has("E"), has("S"), has("F")
         arc = (motion == 3) | (motion == 4)
         has_axes |= arc & has("IJKR")  # "G2 I5" is a full circle from where the tool is
-        is_motion_name = np.isin(name, [NAME_ID[m] for m in MOTION_OF_NAME]) | np.isin(name, self._cycle_ids)
+        is_motion_name = np.isin(name, [NAME_ID[m] for m in _MOTION_MODES]) | np.isin(name, self._cycle_ids)
         implicit = (letter == 0) & has_axes if self._modal_motion else np.zeros(n, bool)
         moving = (is_motion_name | implicit) & (has_axes | has_e)
 
