@@ -370,3 +370,13 @@ def test_g16_under_ger_rules():
     errors = [(d.line, d.message) for d in op.diagnostics if d.severity == "error"]
     assert [line for line, _ in errors] == [2, 3]
     assert "G91" in errors[0][1] and "program zero" in errors[1][1]
+
+
+def test_probe_moves_run_to_their_target():
+    # no probe input: G38.2 feeds all the way, like rs274 standalone; one going nowhere is refused
+    op = gcodekit.gcode_to_operation("G21 G0 Z5\nG38.2 Z-2 F50\nG38.3 Z-2\n", "linuxcnc", plan=False)
+    m = op.motions()
+    assert m[["line", "motion", "z"]].values.tolist()[:2] == [[1, "rapid", 5], [2, "feed", -2]]
+    assert m["feed"].iloc[1] == 50
+    assert [(d.line, d.message) for d in op.diagnostics if d.severity == "error"] == [
+        (3, "Start point too close to probe point")]

@@ -137,6 +137,13 @@ class Machine:
             self._once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
         return _constants_as_views(_with_extra_waypoints(out, extra, n))
 
+    def _check_probes(self, t: CommandTable, start: int, moving: np.ndarray, start_pos: np.ndarray,
+                      position: np.ndarray) -> None:
+        """A probe move (G38.x) must go somewhere: rs274 refuses one that starts at its target."""
+        probes = np.flatnonzero(moving & (t.name[start:start + moving.size] == NAME_ID["probe"]))
+        for i in probes[np.all(np.abs(position[probes] - start_pos[probes]) < 1e-9, axis=1)].tolist():
+            self.diagnostics.report(int(t.line[start + i]), 1, "Start point too close to probe point", kind="machine")
+
     def _check_axis_words(self, table: CommandTable) -> None:
         """U/V/W words name axes this machine lacks: LinuxCNC refuses the block
         (``read_one_item`` in interp_read.cc has no reader for an axis letter
@@ -210,6 +217,7 @@ class Machine:
             if moving.any():
                 s.program_shift[:] = 0.0
         start_pos = np.vstack([s.position[None, :], position[:-1]])
+        self._check_probes(t, start, moving, start_pos, position)
 
         feed_words = _dense(t.params["F"], rows) if "F" in t.params else np.full(n, np.nan)
         if s.feed_mode != "inverse_time":  # G93's F is 1/minutes, not a length

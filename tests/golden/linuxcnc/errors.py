@@ -46,7 +46,6 @@ SKIP = {
     "Named parameter #<_hal[": "HAL pins (rs274 standalone has no HAL)",
     "Unknown m code used: M1": "user M-code M100-M199 (an external program of the machine)",
     "You must specify both X and Y coordinates for Control Points": "NURBS splines (G5.2) not emulated",
-    "Start point too close to probe point": "probing (G38.x) not emulated",
 }
 
 #: Programs gcodekit knows it does not refuse yet, and why.
