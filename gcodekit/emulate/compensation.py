@@ -58,6 +58,8 @@ def compensate(op: "Operation", tools) -> None:
     pending = None  # index in `out` of the previous compensated waypoint
     pending_start, pending_dir = None, None  # where it starts and, for a line, its programmed direction
     side_rows = {int(r): _SIDES[int(t.name[r])] for r in np.flatnonzero(np.isin(t.name, list(_SIDES)))}
+    tool_changes = set(np.flatnonzero(t.name == NAME_ID["tool_change"]).tolist())
+    held: dict[str, float] = {}  # plane axes rs274 re-read from the tool after an M6 (see below)
     current_row = -1
     entry_row = -1  # the command whose entry length was refused
 
@@ -82,10 +84,25 @@ def compensate(op: "Operation", tools) -> None:
                             radius = tools[number].diameter / 2.0 if number in tools else 0.0
                     elif not new and side:
                         side, mode = 0, "exit"
+                if r in tool_changes and mode == "exit" and out["x"]:
+                    # rs274 re-reads its position after M6: the program position becomes
+                    # the compensated one, so the exit starts from there (useful-subroutines.ngc)
+                    (f0, g0, _), _ = PLANES[int(columns["plane"][k])]
+                    held = {"xyz"[f0]: out["xyz"[f0]][-1], "xyz"[g0]: out["xyz"[g0]][-1]}
             current_row = row
         motion = int(columns["motion"][k])
         (f, g, _), _ = PLANES[int(columns["plane"][k])]
         a, b = "xyz"[f], "xyz"[g]
+        if held:
+            given = t.command(row).params if motion else {}
+            for axis in [axis for axis in held if axis.upper() in given]:
+                del held[axis]  # a word for the axis ends the hold
+            changes = dict(held)
+            if mode == "exit" and motion:
+                mode, last_dir, last_corner, pending, last_path = "off", None, None, None, None
+                pending_start, pending_dir = None, None
+            emit(k, **changes)
+            continue
         if mode == "off" or radius <= 0:
             emit(k)
             continue
@@ -102,7 +119,7 @@ def compensate(op: "Operation", tools) -> None:
             pending_start, pending_dir = None, None
             continue
         chord = end - programmed_start
-        if mode == "entry" and entry_row != row and motion < MOTION_CW and np.hypot(*(end - start)) <= radius \
+        if mode == "entry" and entry_row != row and motion < MOTION_CW and np.hypot(*(end - start)) < radius - _TINY \
                 and not _leaves_plane(columns, k, f, g):
             entry_row = row  # once per command
             op.diagnostics.report(int(t.line[row]), 1, "Length of cutter compensation entry move is not "
@@ -116,7 +133,7 @@ def compensate(op: "Operation", tools) -> None:
             r0 = np.hypot(*(programmed_start - center))
             r1 = np.hypot(*(end - center))
             grow = -side if ccw else side  # G41 on a CCW arc is inside it
-            if grow < 0 and r1 <= radius + _TINY:
+            if grow < 0 and r1 < radius - _TINY:  # rs274 lets an arc shrink to a point
                 op.diagnostics.report(int(t.line[row]), 1, "Tool radius not less than arc radius with comp",
                                       kind="machine")
                 emit(k)
