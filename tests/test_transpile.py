@@ -16,10 +16,18 @@ PROGRAMS = sorted(GOLDEN.glob("*.ngc")) + [EXAMPLES / "bracket_mill.ngc"]
 
 
 def path_of(op: gcodekit.Operation) -> np.ndarray:
-    """Machine-frame end points (mm) of every motion, and arc centres where known."""
+    """Machine-frame end points (mm) of every motion, and arc centres where known.
+
+    An arc that compensation shrank to a point is written back as G1, so its
+    centre is left out and its motion counted as a feed.
+    """
     w = op.waypoints
     moved = np.flatnonzero(np.asarray(w["motion"]) > 0)
-    return np.column_stack([np.asarray(w[k], float)[moved] for k in ("x", "y", "z", "a", "b", "c", "cx", "cy", "cz")])
+    path = np.column_stack([np.asarray(w[k], float)[moved] for k in ("x", "y", "z", "a", "b", "c", "cx", "cy", "cz")])
+    before = np.column_stack([np.asarray(w[k], float)[moved - 1] for k in "xyz"])
+    point_arc = np.nansum((path[:, 6:9] - before) ** 2, axis=1) < 1e-18
+    path[point_arc, 6:9] = np.nan
+    return path
 
 
 def operation(path: Path) -> gcodekit.Operation:

@@ -202,7 +202,7 @@ class Transpiler:
                 lines.append(f"{n} G0 {coords}")
                 continue
             feed = f" F{fmt(w['feed'][p] / self.unit)}" if np.isfinite(w["feed"][p]) else ""
-            if motion == 2:
+            if motion == 2 or self._is_point_arc(p):  # a helix of radius 0 is a straight line
                 lines.append(f"{n} G1 {coords}{feed}")
             else:
                 lines.append(f"{n} {self._arc(p, motion)} {coords}{feed}")
@@ -213,6 +213,13 @@ class Transpiler:
         if dwell is not None and k >= 6 and len(lines) >= 2:
             lines.insert(len(lines) - 1, f"{n} G4 P{fmt(dwell)}")
         return lines
+
+    def _is_point_arc(self, p: int) -> bool:
+        """An arc whose radius compensation shrank to nothing (rs274 refuses to read one back)."""
+        w = self.op.waypoints
+        start = np.array([w[a][p - 1] if p > 0 else 0.0 for a in "xyz"])
+        center = np.array([w["cx"][p], w["cy"][p], w["cz"][p]])
+        return bool(np.nansum((center - start) ** 2) < 1e-18)
 
     def _arc(self, p: int, motion: int) -> str:
         w = self.op.waypoints
