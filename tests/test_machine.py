@@ -380,3 +380,11 @@ def test_probe_moves_run_to_their_target():
     assert m["feed"].iloc[1] == 50
     assert [(d.line, d.message) for d in op.diagnostics if d.severity == "error"] == [
         (3, "Start point too close to probe point")]
+
+
+@pytest.mark.parametrize("move, message", [("G1 X2", "Cannot do g1 with zero feed rate"),
+                                           ("G2 X3 I1", "Cannot make arc with zero feed rate")])
+def test_feed_moves_without_feed_are_refused_as_rs274_does(move, message):
+    # messages as rs274 2.9 prints them for these programs
+    op = gcodekit.gcode_to_operation(f"G21 G0 X1\n{move}\nM2\n", "linuxcnc", plan=False)
+    assert [(d.line, d.severity, d.message) for d in op.diagnostics] == [(2, "error", message)]

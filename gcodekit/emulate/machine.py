@@ -360,7 +360,13 @@ class Machine:
             with np.errstate(divide="ignore", invalid="ignore"):
                 time[moving] = path[moving] / (rate[moving] / 60.0)
             bad = moving & ~(rate > 0) & (path > 0)
-            if bad.any():
+            if self.rs274_blocks and (feeding & ~(rate > 0)).any():
+                # RS274NGC refuses the block (interp_convert.cc), moving or not
+                first = int(np.flatnonzero(feeding & ~(rate > 0))[0])
+                arc = motion[first] in (MOTION_CW, MOTION_CCW)
+                self.diagnostics.report(int(t.line[rows][first]), 1, "Cannot make arc with zero feed rate" if arc
+                                        else "Cannot do g1 with zero feed rate", kind="machine")
+            elif bad.any():
                 first = int(np.flatnonzero(bad)[0])
                 self._once("feed", int(t.line[rows][first]), "move with no feed rate (F) in force; its time is unknown")
                 time[bad] = np.nan
