@@ -48,11 +48,11 @@ _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTR
 _MILL = np.array([Kind.MILL, Kind.MOVE_MILL, Kind.ARC_MILL], np.uint8)
 
 
-def polar_mode_rows(table: CommandTable, initially: bool = False) -> np.ndarray:
-    """Which rows run while G16 polar coordinates are in force (table order)."""
+def mode_rows(table: CommandTable, on: str, off: str, initially: bool = False) -> np.ndarray:
+    """Which rows run while the modal switch ``on`` (not yet ``off``) is in force, in table order."""
     switches = np.full(len(table), -1, np.int8)
-    switches[table.name == NAME_ID["polar_on"]] = 1
-    switches[table.name == NAME_ID["polar_off"]] = 0
+    switches[table.name == NAME_ID[on]] = 1
+    switches[table.name == NAME_ID[off]] = 0
     if not (switches >= 0).any():
         return np.full(len(table), initially)
     last = np.maximum.accumulate(np.where(switches >= 0, np.arange(len(table)), -1))
@@ -114,7 +114,7 @@ class Machine:
         special |= (table.motion == MOTION_CYCLE) & np.isin(table.kind, _MOVING)
         if self.rs274_blocks:
             self._check_axis_words(table)
-        special |= polar_mode_rows(table, self.state.polar) & np.isin(table.kind, _MOVING)
+        special |= mode_rows(table, "polar_on", "polar_off", self.state.polar) & np.isin(table.kind, _MOVING)
         for letter in "@^":  # polar words depend on where the tool is: one block at a time
             if letter in table.params:
                 special |= ~np.isnan(table.param(letter)) & np.isin(table.kind, _MOVING)
@@ -162,7 +162,7 @@ class Machine:
 
     def _hold(self, start: int, stop: int, out: dict) -> None:
         """Rows after the program end: nothing moves."""
-        self._fill_state(slice(start, stop), out)
+        self.fill_state(slice(start, stop), out)
         for k, v in zip(AXES.lower(), self.state.position):
             out[k][start:stop] = v
         for k in ("de", "distance", "time"):
@@ -173,7 +173,8 @@ class Machine:
         out["spindle"][start:stop] = self.state.speed * self.state.spindle
         out["feed"][start:stop] = self.state.feed
 
-    def _fill_state(self, rows: slice, out: dict) -> None:
+    def fill_state(self, rows: slice | int, out: dict) -> None:
+        """The modal state columns of waypoint ``rows`` (plane, units, tool, ...)."""
         s = self.state
         out["plane"][rows] = s.plane
         out["units"][rows] = 1 if s.units != 1.0 else 0
@@ -253,7 +254,7 @@ class Machine:
         out["motion"][rows] = motion
         out["cx"][rows], out["cy"][rows], out["cz"][rows] = centers.T
         out["spindle"][rows] = speed * s.spindle
-        self._fill_state(rows, out)
+        self.fill_state(rows, out)
 
         s.position = position[-1].copy()
         if s.feed_mode == "per_minute":

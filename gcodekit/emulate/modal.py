@@ -396,9 +396,4 @@ class ModalHandler:
         out["motion"][row] = motion
         out["cx"][row] = out["cy"][row] = out["cz"][row] = np.nan
         out["spindle"][row] = s.speed * s.spindle
-        out["plane"][row] = s.plane
-        out["units"][row] = 1 if s.units != 1.0 else 0
-        out["tool"][row] = s.tool
-        out["coolant"][row] = s.coolant
-        out["laser"][row] = s.laser
-        out["work_offset"][row] = s.work_offset
+        self.machine.fill_state(row, out)

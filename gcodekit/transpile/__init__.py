@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..emulate.exporters import format_number
-from ..emulate.machine import polar_mode_rows
+from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
 from ..parse.table import CYCLE_NAMES, MOTION_CYCLE, NAMES
 
@@ -84,7 +84,8 @@ class Transpiler:
         # the plane is modal for whoever reads the output: name it on every arc
         # once the program has an arc outside XY
         self._plane_words = bool(np.any(np.asarray(w["plane"])[arcs] != 17))
-        self._polar_rows = polar_mode_rows(self.op.table)  # G16: X radius, Y angle
+        self._polar_rows = mode_rows(self.op.table, "polar_on", "polar_off")  # G16: X radius, Y angle
+        self._incremental_rows = mode_rows(self.op.table, "distance_incremental", "distance_absolute")  # G91
         flavor = self.op.flavor
         #: mm per output length unit from stage 1 on: the machine's own units
         self.unit = 25.4 if flavor is not None and flavor.units == "inch" else 1.0
@@ -248,11 +249,8 @@ class Transpiler:
         return offset
 
     def _incremental(self, row: int) -> bool:
-        """G91 in force at ``row`` (from the distance-mode commands before it)."""
-        t = self.op.table
-        ids = [i for i, nm in enumerate(NAMES) if nm in ("distance_absolute", "distance_incremental")]
-        rows = np.flatnonzero(np.isin(t.name[: row + 1], ids))
-        return bool(rows.size) and NAMES[int(t.name[rows[-1]])] == "distance_incremental"
+        """G91 in force at ``row`` (from the distance-mode commands up to it)."""
+        return bool(self._incremental_rows[row])
 
 
 def _paren(text: str) -> str:
