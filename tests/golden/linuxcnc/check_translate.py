@@ -24,24 +24,15 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-TOOLS = HERE.parents[3] / "shared" / "tools" / "linuxcnc"
 TOLERANCE_MM = 0.0001 * 25.4 * 2  # rs274 prints 4 decimals of inches or mm
 
 sys.path.insert(0, str(HERE.parents[1]))  # tests/, for the golden test's helpers
+sys.path.insert(0, str(HERE))  # regenerate.py, which runs rs274
 
 import gcodekit  # noqa: E402
 from gcodekit.transpile import Transpiler  # noqa: E402
+from regenerate import rerun  # noqa: E402
 from test_linuxcnc_golden import reference_motions, tool_table  # noqa: E402
-
-
-def rs274_motions(program: Path, table: Path):
-    canon = program.with_suffix(".canon")
-    with canon.open("w") as f:
-        subprocess.run([str(TOOLS / "run_rs274.sh"), str(program), str(table)], stdout=f,
-                       stderr=subprocess.DEVNULL, check=False)
-    subprocess.run(["/usr/bin/python3", str(TOOLS / "canon_to_csv.py"), str(canon), "-o", f"{canon}.csv"],
-                   stdout=subprocess.DEVNULL, check=True)
-    return reference_motions(Path(f"{canon}.csv"))
 
 
 def check(case: Path, workdir: Path) -> str | None:
@@ -50,7 +41,12 @@ def check(case: Path, workdir: Path) -> str | None:
     op = gcodekit.gcode_to_operation(case, "linuxcnc", plan=False, tool_table=table, tool_table_units="inch")
     translated = workdir / case.name
     translated.write_text("G21\n" + Transpiler(op).stage(6) + "\nM2\n")
-    ref = rs274_motions(translated, table)
+    canon = translated.with_suffix(".canon")
+    try:
+        rerun(translated, table, canon)
+    except subprocess.CalledProcessError as exc:
+        return f"rs274 refused it ({exc})"
+    ref = reference_motions(Path(f"{canon}.csv"))
     w = op.waypoints
     moved = np.flatnonzero(np.asarray(w["motion"]) > 0)
     ours = np.column_stack([np.asarray(w[k], float)[moved] for k in "xyz"])
