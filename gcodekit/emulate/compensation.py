@@ -70,6 +70,8 @@ def compensate(op: "Operation", tools) -> None:
 
     for k in range(n):
         row = int(rows[k])
+        (f, g, _), _ = PLANES[int(columns["plane"][k])]
+        a, b = "xyz"[f], "xyz"[g]
         if row != current_row:
             for r in range(current_row + 1, row + 1):  # comp codes between the waypoints
                 if r in side_rows:
@@ -87,12 +89,9 @@ def compensate(op: "Operation", tools) -> None:
                 if r in tool_changes and mode == "exit" and out["x"]:
                     # rs274 re-reads its position after M6: the program position becomes
                     # the compensated one, so the exit starts from there (useful-subroutines.ngc)
-                    (f0, g0, _), _ = PLANES[int(columns["plane"][k])]
-                    held = {"xyz"[f0]: out["xyz"[f0]][-1], "xyz"[g0]: out["xyz"[g0]][-1]}
+                    held = {a: out[a][-1], b: out[b][-1]}
             current_row = row
         motion = int(columns["motion"][k])
-        (f, g, _), _ = PLANES[int(columns["plane"][k])]
-        a, b = "xyz"[f], "xyz"[g]
         if held:
             given = t.command(row).params if motion else {}
             for axis in [axis for axis in held if axis.upper() in given]:
