@@ -212,8 +212,7 @@ def velocity_profile(op: "Operation") -> "pd.DataFrame":
     first = np.r_[0, np.flatnonzero(moves.waypoint[1:] != moves.waypoint[:-1]) + 1]
     offset = np.repeat(within[first], np.diff(np.r_[first, len(moves)]))
     t0 = t_start_wp[moves.waypoint] + (within - offset)
-    d = np.linalg.norm(moves.axes_d[:, :3], axis=1)
-    d = np.where(d > 0, d, np.abs(moves.axes_d[:, 3]))
+    d = moves.length_d
     d0 = np.cumsum(d) - d
     accel_d = (r.cruise_v**2 - r.start_v**2) / (2 * r.accel)
     decel_d = (r.cruise_v**2 - r.end_v**2) / (2 * r.accel)

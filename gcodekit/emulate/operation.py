@@ -150,7 +150,7 @@ class Operation:
         self.diagnostics = diagnostics if diagnostics is not None else Diagnostics(file)
         self.n_lines = n_lines
         self._elapsed: np.ndarray | None = None
-        self.plan = None  # (PlannerMoves, PlanResult) once a motion planner has run
+        self.plan = None  # (PlannedMoves, PlanResult) once a motion planner has run
 
     # -- the seed's object API ---------------------------------------------------
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 import numpy as np
 
 from ...errors import ConfigError, did_you_mean
-from .base import PlannerMoves, PlanResult
+from .base import PlannedMoves, PlannerMoves, PlanResult
 
 if TYPE_CHECKING:
     from ..operation import Operation
@@ -66,7 +66,7 @@ def run_planner(op: "Operation", name: str, settings) -> "Operation":
     return op
 
 
-def apply_plan(op: "Operation", moves: PlannerMoves, result: PlanResult) -> None:
+def apply_plan(op: "Operation", moves: PlannerMoves | PlannedMoves, result: PlanResult) -> None:
     """Per-waypoint planned time from per-move results.
 
     A waypoint's ``time`` becomes the sum of its moves' durations (dwells
@@ -78,7 +78,7 @@ def apply_plan(op: "Operation", moves: PlannerMoves, result: PlanResult) -> None
     planned = np.bincount(moves.waypoint, weights=result.duration_t, minlength=n)
     has_moves = np.bincount(moves.waypoint, minlength=n) > 0
     w["time"] = np.where(has_moves, planned, np.where(w["motion"] > 0, 0.0, w["time"]))
-    op.plan = (moves, result)
+    op.plan = (moves.planned() if isinstance(moves, PlannerMoves) else moves, result)
     op._elapsed = None
 
 

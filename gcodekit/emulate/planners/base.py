@@ -61,6 +61,36 @@ class PlannerMoves:
     def select(self, keep: np.ndarray) -> "PlannerMoves":
         return PlannerMoves(self.start[keep], self.end[keep], self.speed_v[keep], self.row[keep], self.waypoint[keep])
 
+    def planned(self) -> "PlannedMoves":
+        """What an operation keeps after planning: no end points, just each move's length."""
+        axes_d = self.axes_d
+        length_d = np.sqrt(np.einsum("ij,ij->i", axes_d[:, :3], axes_d[:, :3]))
+        length_d = np.where(length_d > 0, length_d, np.abs(axes_d[:, 3]))  # extruder-only moves
+        return PlannedMoves(self.speed_v, self.row, self.waypoint, length_d)
+
+
+@dataclass
+class PlannedMoves:
+    """The planned moves an operation keeps (``op.plan``), a quarter of :class:`PlannerMoves`' size.
+
+    Attributes
+    ----------
+    speed_v : ndarray
+        Requested speed (mm/s).
+    row, waypoint : ndarray of int64
+        Command row and waypoint each move comes from.
+    length_d : ndarray
+        Toolhead travel (mm); the extruder's for extruder-only moves.
+    """
+
+    speed_v: np.ndarray
+    row: np.ndarray
+    waypoint: np.ndarray
+    length_d: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.row.size)
+
 
 @dataclass
 class PlanResult:

@@ -214,7 +214,8 @@ def trapezoid(move_d: np.ndarray, accel: np.ndarray, entry_v2: np.ndarray, nomin
     firmware's step generator does.
     """
     n = move_d.size
-    result = PlanResult(*(np.empty(n) for _ in range(7)))
+    result = PlanResult(np.empty(n), np.empty(n), np.empty(n), np.asarray(accel, float), np.empty(n), np.empty(n),
+                        np.empty(n))
     for lo in range(0, n, BLOCK):
         sl = slice(lo, min(lo + BLOCK, n))
         _trapezoid_block(move_d[sl], accel[sl], entry_v2[sl], nominal_v2[sl], exit_v2[sl], result, sl)
@@ -239,7 +240,7 @@ def _trapezoid_block(move_d, accel, entry_v2, nominal_v2, exit_v2, result: PlanR
         result.accel_t[sl] = np.where(accel_d > 0, (cruise_v - start_v) / accel, 0.0)
         result.cruise_t[sl] = np.where(cruise_d > 0, cruise_d / cruise_v, 0.0)
         result.decel_t[sl] = np.where(decel_d > 0, (cruise_v - end_v) / accel, 0.0)
-    result.start_v[sl], result.cruise_v[sl], result.end_v[sl], result.accel[sl] = start_v, cruise_v, end_v, accel
+    result.start_v[sl], result.cruise_v[sl], result.end_v[sl] = start_v, cruise_v, end_v
 
 
 def empty_result() -> PlanResult:

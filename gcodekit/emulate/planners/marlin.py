@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import ConfigError
-from .base import (PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force,
+from .base import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force,
                    m204_in_force, speed_factor)
 from .grbl import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
 
@@ -241,7 +241,7 @@ def _program_limits(op: "Operation", moves: PlannerMoves, config: MarlinConfig) 
     return limits
 
 
-def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResult]:
+def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult]:
     """Plan an emulated operation as Marlin 2 would; one result per firmware move.
 
     Examples
@@ -267,8 +267,10 @@ def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResul
     block = {name: np.empty(n) for name in ("millimeters", "acceleration", "nominal_speed", "max_entry_speed_sqr")}
     for lo in range(0, n, BLOCK):
         _populate_blocks(moves, lim, rest_before, config, lo, min(lo + BLOCK, n), block)
-
+    del lim
     millimeters, acceleration, nominal_speed = block["millimeters"], block["acceleration"], block["nominal_speed"]
+    planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, millimeters)
+    del moves  # the end points are no longer needed: free them before the passes
     minimum_planner_speed_sqr = config.minimum_planner_speed**2
     delta_v2 = 2.0 * acceleration * millimeters
     nominal_speed_sqr = nominal_speed * nominal_speed
@@ -278,7 +280,8 @@ def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves, PlanResul
     rest_after = np.r_[rest_before[1:], True]
     entry_speed_sqr, exit_speed_sqr = lookahead(block["max_entry_speed_sqr"], delta_v2, rest_after,
                                                 rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
-    return moves, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr)
+    del block, delta_v2, nominal_length, rest_after
+    return planned, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr)
 
 
 def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, config: MarlinConfig,
