@@ -81,5 +81,6 @@ def test_translate_writes_plain_gcode(tmp_path, capsys):
     status, _, _ = run(["translate", MILL, "--stage", "6", "-o", target], capsys)
     assert status == 0
     body = [line for line in target.read_text().splitlines() if not line.startswith("(")]
-    assert body and all(line.split()[1] in ("G0", "G1", "G2", "G3", "G4", "M3", "M5", "M6", "M8", "M9")
-                        for line in body)
+    assert body[0] == "G21"  # the output names its units
+    assert body[1:] and all(line.split()[1] in ("G0", "G1", "G2", "G3", "G4", "M2", "M3", "M5", "M6", "M8", "M9",
+                                                "M30") for line in body[1:])

@@ -71,6 +71,8 @@ def test_last_stage_vocabulary_and_line_numbers():
     t = Transpiler("G21 G0 X0 Y0 Z5\nG55 G81 X10 Y10 Z-2 R1 F100\nX20\nG80\nG91 G1 X5\nM2\n", "linuxcnc",
                    work_offsets={"G55": (100.0, 0.0, 0.0)})
     lines = [line for line in t.stage(6).splitlines() if not line.startswith("(")]
+    assert lines[0] == "G21" and lines[-1] == "N6 M2"  # it names its units, and the program still ends
+    lines = lines[1:-1]
     assert all(line.split()[1] in ("G0", "G1", "G2", "G3", "G4") for line in lines)
     assert [line.split()[0] for line in lines] == ["N1"] + ["N2"] * 4 + ["N3"] * 4 + ["N5"]
     assert lines[2] == "N2 G0 X110 Y10 Z1"  # the G55 offset is in the coordinates now

@@ -14,6 +14,8 @@ before its own, each pointing back to the command.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..errors import Diagnostics
@@ -99,6 +101,22 @@ class Machine:
 
     # -- running ----------------------------------------------------------------
 
+    def _radius_words(self, table: CommandTable) -> CommandTable:
+        """The table as the machine reads it under G7: X words halved (diameters to radii).
+
+        rs274 halves X on moves, canned cycles, G92 and G52, but not G10's
+        offsets, and never I (an arc centre's X offset stays a radius).  The
+        parsed table keeps the program's own words.
+        """
+        if "X" not in table.params:
+            return table
+        diameter = mode_rows(table, "diameter_mode", "radius_mode", self.state.diameter)
+        diameter &= table.name != NAME_ID["coordinate_data"]
+        x = table.param("X")
+        if not (diameter & ~np.isnan(x)).any():
+            return table
+        return dataclasses.replace(table, params={**table.params, "X": np.where(diameter, x / 2.0, x)})
+
     def run(self, table: CommandTable) -> dict[str, np.ndarray]:
         """Waypoint columns for ``table``: one per command plus any extra ones.
 
@@ -106,6 +124,7 @@ class Machine:
         :data:`SMALL_COLUMNS` arrays and ``command`` (row of the command each
         waypoint belongs to) when some command added waypoints.
         """
+        table = self._radius_words(table)
         n = len(table)
         out = {k: np.empty(n) for k in FLOAT_COLUMNS}
         out.update({k: np.empty(n, dtype) for k, (dtype, _) in SMALL_COLUMNS.items()})

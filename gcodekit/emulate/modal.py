@@ -34,7 +34,7 @@ SPECIAL_NAMES = frozenset(
     coolant_mist coolant_flood coolant_off program_end machine_coordinates
     firmware_retract firmware_unretract set_kinematic_position
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
-    coordinate_data local_offset retract_initial retract_r laser_on laser_off polar_on polar_off""".split()
+    coordinate_data local_offset retract_initial retract_r laser_on laser_off polar_on polar_off diameter_mode radius_mode""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)}
 
 _MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
@@ -48,6 +48,7 @@ _SIMPLE = {
     "feed_per_rev": ("feed_mode", "per_rev"),
     "extrude_absolute": ("e_relative", False), "extrude_relative": ("e_relative", True),
     "polar_on": ("polar", True), "polar_off": ("polar", False),
+    "diameter_mode": ("diameter", True), "radius_mode": ("diameter", False),
 }
 
 

@@ -31,6 +31,7 @@ class MachineState:
     units: float = 1.0  # mm per program unit: 1 (G21) or 25.4 (G20)
     incremental: bool = False  # G91
     polar: bool = False  # G16 (Fanuc, GER): X is a radius, Y an angle in degrees
+    diameter: bool = False  # G7 (LinuxCNC lathes): X words are diameters
     arc_incremental: bool = True  # G91.1 (the default) or G90.1
     plane: int = 17
     feed: float = np.nan  # mm/min, or 1/min in inverse-time mode

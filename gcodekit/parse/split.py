@@ -47,7 +47,7 @@ _RANK = {
     "cancel_tool_length": 18,
     **{f"work_offset_{k}": 19 for k in range(1, 10)},
     "exact_stop": 20, "path_blending": 20, "retract_initial": 22, "retract_r": 22,
-    "distance_absolute": 21, "distance_incremental": 21,
+    "distance_absolute": 21, "distance_incremental": 21, "diameter_mode": 21, "radius_mode": 21,
     "arc_distance_absolute": 21, "arc_distance_incremental": 21,
     "set_position": 23, "clear_position_offset": 23, "suspend_position_offset": 23,
     "restore_position_offset": 23, "home": 23, "home_secondary": 23,

@@ -37,7 +37,7 @@ COMMANDS = frozenset(
     coolant_mist coolant_flood coolant_off
     program_stop optional_stop program_end
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
-    coordinate_data local_offset polar_on polar_off
+    coordinate_data local_offset polar_on polar_off diameter_mode radius_mode
     cutter_comp_off cutter_comp_left cutter_comp_right cutter_comp_left_dynamic cutter_comp_right_dynamic
     cancel_cycle exact_stop path_blending retract_initial retract_r
     cycle_drill cycle_drill_dwell cycle_peck cycle_chip_break cycle_bore cycle_bore_stop cycle_bore_dwell

@@ -5,7 +5,8 @@ what a controller does with each (GER manual, "Simplify 00-05", extended
 with canned cycles):
 
 0. subprograms, loops and macros expanded (the program as it runs);
-1. lengths in the machine's units (G20/G21 gone);
+1. lengths in the machine's units (G20/G21 gone), lathe X diameters as
+   radii (G7/G8 gone);
 2. work offsets, G92, G52 and tool-length offsets applied (machine coordinates);
 3. polar words (LinuxCNC ``@``/``^``) turned into X and Y; G16 moves go
    at stage 2 already, since their pole is the program origin the offsets move;
@@ -22,11 +23,13 @@ waypoints; stages 1-3 rewrite the words of each command.
 Examples
 --------
 >>> from gcodekit.transpile import Transpiler
->>> t = Transpiler("G20 G91 G0 X1\\nX1\\n", machine="linuxcnc")
+>>> t = Transpiler("G20 G91 G0 X1\\nX1\\nM2\\n", machine="linuxcnc")
 >>> print(t.stage(6))
 (gcodekit transpile stage 6: machine units mm, absolute machine coordinates)
+G21
 N1 G0 X25.4 Y0 Z0
 N2 G0 X50.8 Y0 Z0
+N3 M2
 <BLANKLINE>
 """
 
@@ -37,12 +40,12 @@ import numpy as np
 from ..emulate.exporters import format_number
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
-from ..parse.table import CYCLE_NAMES, MOTION_CYCLE, NAMES
+from ..parse.table import CYCLE_NAMES, MOTION_CYCLE, NAME_ID, NAMES
 
 STAGES = tuple(range(7))
 STAGE_NAMES = ("expanded", "units", "offsets", "polar", "absolute", "cutter compensation", "canned cycles")
 
-_UNITS = {"units_inch", "units_mm"}
+_UNITS = {"units_inch", "units_mm", "diameter_mode", "radius_mode"}
 _OFFSETS = {"work_offset_%d" % k for k in range(1, 10)} | {
     "set_position", "clear_position_offset", "suspend_position_offset", "restore_position_offset",
     "local_offset", "coordinate_data", "tool_length_offset", "tool_length_offset_dynamic",
@@ -52,9 +55,9 @@ _CYCLE_MODES = {"cancel_cycle", "retract_initial", "retract_r"}
 _COMP = {"cutter_comp_off", "cutter_comp_left", "cutter_comp_right", "cutter_comp_left_dynamic",
          "cutter_comp_right_dynamic"}
 _POLAR = {"polar_on", "polar_off"}
-#: What the last stage keeps besides motion: dwell, tools, spindle, coolant.
+#: What the last stage keeps besides motion: dwell, tools, spindle, coolant, stops and the end.
 _KEPT = {"dwell", "tool_change", "spindle_cw", "spindle_ccw", "spindle_off", "coolant_mist", "coolant_flood",
-         "coolant_off"}
+         "coolant_off", "program_stop", "optional_stop", "program_end"}
 _LENGTH_WORDS = set("XYZUVWIJKRQ")
 
 
@@ -86,6 +89,9 @@ class Transpiler:
         self._plane_words = bool(np.any(np.asarray(w["plane"])[arcs] != 17))
         self._polar_rows = mode_rows(self.op.table, "polar_on", "polar_off")  # G16: X radius, Y angle
         self._incremental_rows = mode_rows(self.op.table, "distance_incremental", "distance_absolute")  # G91
+        # G7: X words are diameters, except G10's (as rs274 reads them)
+        self._diameter_rows = mode_rows(self.op.table, "diameter_mode", "radius_mode") & (
+            self.op.table.name != NAME_ID["coordinate_data"])
         flavor = self.op.flavor
         #: mm per output length unit from stage 1 on: the machine's own units
         self.unit = 25.4 if flavor is not None and flavor.units == "inch" else 1.0
@@ -102,8 +108,12 @@ class Transpiler:
         unit_name = "inch" if self.unit == 25.4 else "mm"
         lines = [f"(gcodekit transpile stage {k}: machine units {unit_name}, {frame})" if k >= 1 else
                  "(gcodekit transpile stage 0: subprograms, loops and macros expanded)"]
+        if k >= 1:  # the output says its units, so any controller reads it the same
+            lines.append("G20" if self.unit == 25.4 else "G21")
         for row in range(len(self.op.table)):
             lines.extend(self._row(row, k))
+        if not (self.op.table.name == NAME_ID["program_end"]).any():
+            lines.append("M2 (the source ends without M2 or M30)")  # rs274 refuses a file with no end
         return "\n".join(lines) + "\n"
 
     def commands(self, k: int):
@@ -167,6 +177,8 @@ class Transpiler:
                 continue
             angle = letter == "Y" and self._polar_rows[row]  # G16: Y is an angle in degrees
             v = value * scale if (letter in _LENGTH_WORDS or letter == "F") and not angle else value
+            if letter == "X" and k >= 1 and self._diameter_rows[row]:
+                v /= 2.0
             if absolute and letter in "XYZ" and k >= 2:
                 v += offset["XYZ".index(letter)]
             words.append(f"{letter}{format_number(v, self.precision)}")

@@ -40,7 +40,7 @@ def check(case: Path, workdir: Path) -> str | None:
     table = tool_table(case.name)
     op = gcodekit.gcode_to_operation(case, "linuxcnc", plan=False, tool_table=table, tool_table_units="inch")
     translated = workdir / case.name
-    translated.write_text("G21\n" + Transpiler(op).stage(6) + "\nM2\n")
+    translated.write_text(Transpiler(op).stage(6))
     canon = translated.with_suffix(".canon")
     try:
         rerun(translated, table, canon)
