@@ -15,10 +15,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, NAMES,
-                           CommandTable)
+from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_RAPID,
+                           NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
 from ..parse.commands import Kind
 from .cycles import CYCLES, polar_target, run_cycle
+from .splines import SPLINE_NAMES, SplineBlocks
 from .state import AXES, MachineState
 from .tooltable import Tool
 
@@ -35,7 +36,7 @@ SPECIAL_NAMES = frozenset(
     firmware_retract firmware_unretract set_kinematic_position
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
     coordinate_data local_offset retract_initial retract_r laser_on laser_off polar_on polar_off diameter_mode radius_mode""".split()
-) | {f"work_offset_{k}" for k in range(1, 10)}
+) | {f"work_offset_{k}" for k in range(1, 10)} | SPLINE_NAMES
 
 _MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
 _PROGRAM_ZERO = frozenset({"local_offset", "set_position", "clear_position_offset"})  # G52, G92, G92.1
@@ -67,6 +68,7 @@ class ModalHandler:
         self.special_ids = np.array(sorted(NAME_ID[n] for n in SPECIAL_NAMES), np.uint8)
         self._last_dwell = 0.0  # dwell at the end of a canned cycle's last move
         self._tool_change_line = -1  # source line of the last M6 (see tool length offsets)
+        self.splines = SplineBlocks(machine.config.spline_tolerance)
 
     @property
     def state(self) -> MachineState:
@@ -94,6 +96,8 @@ class ModalHandler:
                                             "are on", kind="machine")
         if moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
             motion, extra = self._cycle(name, params, line)
+        elif name in SPLINE_NAMES or (moves and int(t.motion[row]) in SPLINE_MOTIONS):
+            motion, extra = self._spline(t, row, name, params)
         elif moves and ("@" in params or "^" in params):
             motion = self._polar_move(params, int(t.motion[row]), line)
         elif s.polar and (moves or int(t.motion[row]) in (MOTION_CW, MOTION_CCW)):
@@ -206,6 +210,38 @@ class ModalHandler:
         s.position = steps[-1].point.copy()
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
+
+    def _spline(self, t: CommandTable, row: int, name: str, params: dict) -> tuple[int, list[Waypoint]]:
+        """G5, G5.1, G5.2/G5.3 and the control points between: the curve's chords become
+        waypoints (see :mod:`.splines`)."""
+        s = self.state
+        line = int(t.line[row])
+        mode_before = int(t.motion[row - 1]) if row else MOTION_NURBS  # (a chunk's first row: trust it)
+        problem = ""
+        if not name and int(t.motion[row]) != MOTION_NURBS:
+            problem = "Cannot use axis values without a g code that uses them"  # rs274: G5/G5.1 are not modal
+        elif name == "nurbs_end" and mode_before != MOTION_NURBS:
+            problem = "Cannot use G5.3 without G5.2 first"
+            self.splines.discard()
+        elif name in ("spline_cubic", "spline_quadratic") and s.plane != 17:  # rs274 draws a NURBS in XY anyway
+            problem = "Splines must be in the XY plane"
+        elif name in ("spline_cubic", "spline_quadratic") and any(letter in params for letter in "ZABC"):
+            problem = "Splines may not have motion in Z, A, B, or C"
+        name = name or "nurbs_point"
+        try:
+            if problem:
+                raise ValueError(problem)
+            chords = self.splines.block(name, params, s.program_position()[:2], float(s.scale()[0]), s.incremental)
+        except ValueError as exc:
+            self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
+            return MOTION_NONE, []
+        if chords is None:
+            return MOTION_NONE, []
+        points = np.repeat(s.position[None, :], len(chords) - 1, axis=0)
+        points[:, :2] = chords[1:] + s.offset[:2]
+        extra = [Waypoint({**dict(zip(AXES.lower(), p)), "motion": MOTION_LINEAR}) for p in points[:-1]]
+        s.position = points[-1].copy()
+        return MOTION_LINEAR, extra
 
     def _radius_angle_move(self, params: dict, motion: int, line: int) -> int:
         """G0/G1 under G16 (Fanuc, GER): X the radius, Y the angle in degrees.

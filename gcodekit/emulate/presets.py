@@ -93,6 +93,8 @@ class MachineConfig:
         time as length over feed.
     planner_settings : mapping
         The planner's settings (the ``[planner]`` table), e.g. ``max_accel``.
+    spline_tolerance : float
+        mm; the chords that follow a G5/G5.1/G5.2 curve stay this close to it.
     """
 
     name: str
@@ -121,6 +123,7 @@ class MachineConfig:
     dwell_s_seconds: bool = True
     planner: str = ""
     planner_settings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+    spline_tolerance: float = 0.001
 
     def __hash__(self) -> int:
         return hash(self.name)

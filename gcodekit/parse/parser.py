@@ -24,7 +24,8 @@ from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
-from .table import CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_OF_NAME, NAME_ID, CommandTable
+from .table import (CYCLE_NAMES, MOTION_CUBIC, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
+                    MOTION_QUADRATIC, NAME_ID, CommandTable)
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
 _KEEP = 255  # "this row does not set the motion mode"
@@ -35,7 +36,8 @@ _LETTER_ROW[[ord(c) for c in PARAM_LETTERS]] = np.arange(len(PARAM_LETTERS))
 
 #: Motion modes by command name.  A probe (G38.x) is a straight feed to its
 #: target: without a probe input it never trips, as in rs274 standalone.
-_MOTION_MODES = {**MOTION_OF_NAME, "probe": MOTION_LINEAR}
+_MOTION_MODES = {**MOTION_OF_NAME, "probe": MOTION_LINEAR, "spline_cubic": MOTION_CUBIC,
+                 "spline_quadratic": MOTION_QUADRATIC, "nurbs_start": MOTION_NURBS}
 
 
 class GcodeParser:
@@ -265,7 +267,7 @@ class GcodeParser:
         sets = np.full(n, _KEEP, np.uint8)
         for mname, mode in _MOTION_MODES.items():
             sets[name == NAME_ID[mname]] = mode
-        sets[name == NAME_ID["cancel_cycle"]] = MOTION_NONE
+        sets[(name == NAME_ID["cancel_cycle"]) | (name == NAME_ID["nurbs_end"])] = MOTION_NONE
         sets[np.isin(name, self._cycle_ids)] = MOTION_CYCLE
         g53 = name == NAME_ID["machine_coordinates"]
         for i in np.flatnonzero(g53 & (letter != 0)):

@@ -22,6 +22,10 @@ NAME_ID: dict[str, int] = {n: i for i, n in enumerate(NAMES)}
 MOTION_NONE, MOTION_RAPID, MOTION_LINEAR, MOTION_CW, MOTION_CCW, MOTION_CYCLE = range(6)
 MOTION_NAMES = ("", "rapid", "feed", "arc_cw", "arc_ccw")
 MOTION_OF_NAME = {"rapid": MOTION_RAPID, "linear": MOTION_LINEAR, "arc_cw": MOTION_CW, "arc_ccw": MOTION_CCW}
+#: Splines (G5 cubic, G5.1 quadratic, G5.2 NURBS): table motion modes only; their
+#: waypoints are the chords that follow the curve (MOTION_LINEAR)
+MOTION_CUBIC, MOTION_QUADRATIC, MOTION_NURBS = 6, 7, 8
+SPLINE_MOTIONS = (MOTION_CUBIC, MOTION_QUADRATIC, MOTION_NURBS)
 #: Canned cycles: the command table's motion is MOTION_CYCLE (never a waypoint's)
 CYCLE_NAMES = ("cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
                "cycle_bore_stop", "cycle_bore_dwell", "cycle_tap", "cycle_tap_left", "cycle_back_bore",

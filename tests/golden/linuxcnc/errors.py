@@ -45,7 +45,6 @@ FILE_ENDED = "File ended with no percent sign"
 SKIP = {
     "Named parameter #<_hal[": "HAL pins (rs274 standalone has no HAL)",
     "Unknown m code used: M1": "user M-code M100-M199 (an external program of the machine)",
-    "You must specify both X and Y coordinates for Control Points": "NURBS splines (G5.2) not emulated",
 }
 
 #: Programs gcodekit knows it does not refuse yet, and why.
