@@ -31,8 +31,9 @@ from gcodekit.preprocess import expressions
         ("[1 EQ 1]", 1.0), ("[1 EQ 1.00005]", 1.0), ("[1 EQ 1.001]", 0.0),
         ("[1 NE 1.00005]", 0.0), ("[1 NE 2]", 1.0),
         ("[2 GT 1]", 1.0), ("[1 GT 1]", 0.0), ("[1.00005 GT 1]", 1.0),
-        ("[1 GE 1.00005]", 1.0), ("[1 GE 2]", 0.0),
-        ("[1 LT 2]", 1.0), ("[1 LT 1]", 0.0), ("[1 LE 0.99995]", 1.0), ("[2 LE 1]", 0.0),
+        # EQ/NE have rs274's 0.0001 tolerance, GE/LE do not (both checked in rs274 2.9)
+        ("[1 GE 1.00005]", 0.0), ("[1 GE 1]", 1.0), ("[1 GE 2]", 0.0),
+        ("[1 LT 2]", 1.0), ("[1 LT 1]", 0.0), ("[1 LE 0.99995]", 0.0), ("[1 LE 1]", 1.0), ("[2 LE 1]", 0.0),
         ("[1 AND 2]", 1.0), ("[1 AND 0]", 0.0), ("[0 OR 0]", 0.0), ("[0 OR -3]", 1.0),
         ("[1 XOR 1]", 0.0), ("[1 XOR 0]", 1.0), ("[0 XOR 0]", 0.0),
         # precedence: ** then * / MOD then + - then relational then logical
@@ -336,7 +337,7 @@ def binary(op, a, b):
         return result
     near = abs(a - b) < 0.0001
     truth = {
-        "EQ": near, "NE": not near, "GT": a > b, "GE": near or a > b, "LT": a < b, "LE": near or a < b,
+        "EQ": near, "NE": not near, "GT": a > b, "GE": a >= b, "LT": a < b, "LE": a <= b,
         "AND": a != 0 and b != 0, "OR": a != 0 or b != 0, "XOR": (a != 0) != (b != 0),
     }[op]
     return 1.0 if truth else 0.0

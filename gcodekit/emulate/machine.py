@@ -20,8 +20,8 @@ import numpy as np
 
 from ..errors import Diagnostics
 from ..parse.commands import Kind
-from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, NAME_ID, SPLINE_MOTIONS,
-                           CommandTable)
+from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, MOTION_THREAD, NAME_ID,
+                           SPLINE_MOTIONS, CommandTable)
 from . import arcs
 from .modal import ModalHandler, Waypoint
 from .presets import MachineConfig
@@ -131,7 +131,7 @@ class Machine:
         out.update({k: np.empty(n, dtype) for k, (dtype, _) in SMALL_COLUMNS.items()})
         special = np.isin(table.name, self.modal.special_ids) | (table.letter == ord("T"))
         special |= table.kind == Kind.MACHINE_COORDINATES
-        special |= np.isin(table.motion, (MOTION_CYCLE,) + SPLINE_MOTIONS) & np.isin(table.kind, _MOVING)
+        special |= np.isin(table.motion, (MOTION_CYCLE, MOTION_THREAD) + SPLINE_MOTIONS) & np.isin(table.kind, _MOVING)
         if self.rs274_blocks:
             self._check_axis_words(table)
         special |= mode_rows(table, "polar_on", "polar_off", self.state.polar) & np.isin(table.kind, _MOVING)

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_RAPID,
-                           NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
+                           MOTION_THREAD, NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
 from ..parse.commands import Kind
 from .cycles import CYCLES, polar_target, run_cycle
 from .splines import SPLINE_NAMES, SplineBlocks
@@ -96,6 +96,12 @@ class ModalHandler:
                                             "are on", kind="machine")
         if moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
             motion, extra = self._cycle(name, params, line)
+        elif moves and int(t.motion[row]) == MOTION_THREAD:
+            rate = self._thread(params, line)
+            if rate is not None:
+                s.program_shift[:] = 0.0
+                self._write(out, row, before, MOTION_LINEAR, feed=rate)
+                return extra
         elif name in SPLINE_NAMES or (moves and int(t.motion[row]) in SPLINE_MOTIONS):
             motion, extra = self._spline(t, row, name, params)
         elif moves and ("@" in params or "^" in params):
@@ -210,6 +216,23 @@ class ModalHandler:
         s.position = steps[-1].point.copy()
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
+
+    def _thread(self, params: dict, line: int) -> float | None:
+        """G33: a straight move at K units per spindle revolution; returns its feed (mm/min), None if refused."""
+        s = self.state
+        problem = ("K word missing with g33/g33.1" if "K" not in params else
+                   "F word used with a g33/g33.1" if "F" in params else
+                   "Spindle not turning in G33" if s.spindle == 0 or s.speed <= 0 else "")
+        if problem:
+            self.machine.diagnostics.report(line, 1, problem, kind="machine")
+            return None
+        scale = s.scale()
+        program = s.program_position()
+        for ax, letter in enumerate("XY"):
+            if letter in params:
+                program[ax] = (program[ax] if s.incremental else 0.0) + params[letter] * scale[ax]
+        self._move_to(program, params)
+        return params["K"] * scale[2] * s.speed
 
     def _spline(self, t: CommandTable, row: int, name: str, params: dict) -> tuple[int, list[Waypoint]]:
         """G5, G5.1, G5.2/G5.3 and the control points between: the curve's chords become

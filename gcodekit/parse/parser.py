@@ -25,7 +25,7 @@ from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
 from .table import (CYCLE_NAMES, MOTION_CUBIC, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
-                    MOTION_QUADRATIC, NAME_ID, CommandTable)
+                    MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable)
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
 _KEEP = 255  # "this row does not set the motion mode"
@@ -37,7 +37,7 @@ _LETTER_ROW[[ord(c) for c in PARAM_LETTERS]] = np.arange(len(PARAM_LETTERS))
 #: Motion modes by command name.  A probe (G38.x) is a straight feed to its
 #: target: without a probe input it never trips, as in rs274 standalone.
 _MOTION_MODES = {**MOTION_OF_NAME, "probe": MOTION_LINEAR, "spline_cubic": MOTION_CUBIC,
-                 "spline_quadratic": MOTION_QUADRATIC, "nurbs_start": MOTION_NURBS}
+                 "spline_quadratic": MOTION_QUADRATIC, "nurbs_start": MOTION_NURBS, "thread": MOTION_THREAD}
 
 
 class GcodeParser:

@@ -30,10 +30,10 @@ CYCLES = frozenset({"cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cyc
 AXIS_CONSUMERS = frozenset(
     {"rapid", "linear", "arc_cw", "arc_ccw", "set_position", "home", "home_secondary",
      "machine_coordinates", "probe", "coordinate_data", "local_offset", "tool_length_offset_dynamic",
-     "spline_cubic", "spline_quadratic", "nurbs_start"}
+     "spline_cubic", "spline_quadratic", "nurbs_start", "thread"}
 ) | CYCLES
 MOTIONS = frozenset({"rapid", "linear", "arc_cw", "arc_ccw", "probe", "cancel_cycle", "spline_cubic",
-                     "spline_quadratic", "nurbs_start", "nurbs_end"}) | CYCLES
+                     "spline_quadratic", "nurbs_start", "nurbs_end", "thread"}) | CYCLES
 
 # Rank of each normalized command in LinuxCNC's order of execution
 # (LinuxCNC 2.9 docs, "G-code overview: order of execution").
@@ -56,7 +56,7 @@ _RANK = {
     "store_home": 23, "store_home_secondary": 23, "coordinate_data": 23, "local_offset": 23,
     "machine_coordinates": 24, "rapid": 24, "linear": 24, "arc_cw": 24, "arc_ccw": 24,
     "probe": 24, "cancel_cycle": 24, **dict.fromkeys(CYCLES, 24),
-    "spline_cubic": 24, "spline_quadratic": 24, "nurbs_start": 24, "nurbs_end": 24,
+    "spline_cubic": 24, "spline_quadratic": 24, "nurbs_start": 24, "nurbs_end": 24, "thread": 24,
     "program_stop": 25, "optional_stop": 25, "program_end": 25,
 }
 _RANK_OTHER_M = 13

@@ -26,6 +26,8 @@ MOTION_OF_NAME = {"rapid": MOTION_RAPID, "linear": MOTION_LINEAR, "arc_cw": MOTI
 #: waypoints are the chords that follow the curve (MOTION_LINEAR)
 MOTION_CUBIC, MOTION_QUADRATIC, MOTION_NURBS = 6, 7, 8
 SPLINE_MOTIONS = (MOTION_CUBIC, MOTION_QUADRATIC, MOTION_NURBS)
+#: G33 spindle-synchronized moves: a table motion mode; the waypoint is MOTION_LINEAR
+MOTION_THREAD = 9
 #: Canned cycles: the command table's motion is MOTION_CYCLE (never a waypoint's)
 CYCLE_NAMES = ("cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
                "cycle_bore_stop", "cycle_bore_dwell", "cycle_tap", "cycle_tap_left", "cycle_back_bore",

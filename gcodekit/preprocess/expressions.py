@@ -14,8 +14,9 @@ LinuxCNC 2.9's ``interp_read.cc`` and ``interp_execute.cc``:
 * Binary operators appear only inside brackets, left associative, from
   highest to lowest precedence: ``**``; ``*`` ``/`` ``MOD``; ``+`` ``-``;
   ``EQ NE GT GE LT LE``; ``AND OR XOR``.
-* Angles are in degrees.  Comparisons and logic give 1.0 or 0.0; ``EQ``,
-  ``NE``, ``GE`` and ``LE`` treat numbers within 0.0001 as equal.
+* Angles are in degrees.  Comparisons and logic give 1.0 or 0.0; ``EQ``
+  and ``NE`` treat numbers within 0.0001 as equal, the others compare
+  exactly (as rs274 does: ``[0.03755 LE 0.0375]`` is 0).
 
 The parser reads the folded characters directly rather than a token list:
 LinuxCNC's reader is character driven (a sign followed by a digit is part of
@@ -50,7 +51,7 @@ MAX_DEPTH = 64
 #: Longest text, in characters, the parser accepts (LinuxCNC stops at 255).
 MAX_LENGTH = 10_000
 
-#: RS274NGC's tolerance for EQ, NE, GE and LE (LinuxCNC ``TOLERANCE_EQUAL``).
+#: RS274NGC's tolerance for EQ and NE (LinuxCNC ``TOLERANCE_EQUAL``).
 EQUAL_TOLERANCE = 0.0001
 
 #: Binary operators and their precedence (LinuxCNC ``Interp::precedence``).
@@ -512,8 +513,8 @@ def _binary(op: str, a: float, b: float, col: int) -> float:
             "ne": not near,
             "lt": a < b,
             "gt": a > b,
-            "le": near or a <= b,
-            "ge": near or a >= b,
+            "le": a <= b,
+            "ge": a >= b,
         }[op]
     )
 

@@ -22,7 +22,7 @@ BLOCK_SPLITS = ("modal", "single", "sequential")
 #: Normalized command names a flavor's ``[codes]`` table may map to.
 COMMANDS = frozenset(
     """
-    rapid linear arc_cw arc_ccw dwell spline_cubic spline_quadratic nurbs_start nurbs_end
+    rapid linear arc_cw arc_ccw dwell spline_cubic spline_quadratic nurbs_start nurbs_end thread
     plane_xy plane_zx plane_yz units_inch units_mm
     distance_absolute distance_incremental arc_distance_absolute arc_distance_incremental
     feed_inverse_time feed_per_minute feed_per_rev
