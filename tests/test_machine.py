@@ -323,7 +323,7 @@ def test_incremental_canned_cycle_repeats():
     holes = m[m["motion"] == "feed"]
     assert holes["x"].tolist() == [10.0, 20.0, 30.0]
     assert holes["z"].tolist() == [-2.0, -2.0, -2.0]
-    assert m["z"].iloc[-1] == 5.0  # G98 (default): back to the start height
+    assert m["z"].iloc[-1] == 2.0  # rs274 starts in G99: back to R (checked in rs274 2.9)
 
 
 def test_inverse_time_feed_is_not_scaled_by_inches():

@@ -6,13 +6,15 @@ Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
   G19); "Z" below means that axis, "XY" the two others.
 * R, Z, P and Q stay in force while the cycle mode lasts; a later block with
   only X/Y drills again at the new place.
+* The "old Z" of every block is the level where the cycle mode began (rs274's
+  ``cycle_il``), kept until G80 or another motion mode ends it.
 * Absolute mode: R and Z are coordinates.  Incremental mode (G91): R is
-  measured from the tool's Z before the block, Z from R, and X/Y are
-  increments repeated L times.
-* Before the first hole, if the tool is below R, it rapids up to R.  At each
-  hole: rapid over the hole (even when already there), rapid down to R if
-  above it, the cycle's own moves, then a rapid retract to the clear height: the Z before the block (G98, if that is
-  above R) or R (G99).
+  measured from the old Z, Z from R, and X/Y are increments repeated L times.
+* If the old Z is below R, every block first rapids up to R where the tool
+  is (a zero-length move once it is there).  At each hole: rapid over the
+  hole (even when already there; under G98 at the clear height), rapid down to R if above it, the cycle's
+  own moves, then a rapid retract to the clear height: the old Z (G98, if
+  that is above R) or R (G99).
 * G84 and G74 feed out again (the spindle reversed); G88 stops at the bottom for a
   manual retract, so the cycle itself never leaves the hole; G87 steps aside
   by I/J, drops below the part, bores up to K (G91: K from Z) and back, then
@@ -60,6 +62,9 @@ class CycleState:
     shift: np.ndarray | None = None  # G87: I/J, the side step off the hole centre (mm)
     k: float | None = None  # G87: the level the back bore reaches (program mm)
     retract_to_r: bool = False  # G99
+    #: Program position when the cycle mode began (rs274's ``cycle_il``): its
+    #: drilling-axis level is the "old Z" of every block until the mode ends
+    initial: np.ndarray | None = None
 
 
 def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarray, program: np.ndarray,
@@ -92,16 +97,15 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
     repeats = int(params.get("L", 1))
     if repeats < 1:
         return []
-    old = program[axis]  # the drilling axis before the block, program coordinates (mm)
+    if cycle.initial is None:
+        cycle.initial = program.copy()
+    old = cycle.initial[axis]  # the level where the cycle mode began, program coordinates (mm)
     r = old + cycle.r if incremental else cycle.r
     bottom = r + cycle.z if incremental else cycle.z
     if cycle.name in ("cycle_peck", "cycle_chip_break") and not (cycle.q and cycle.q > 0):
         raise ValueError("G73/G83 need a positive Q")
     clear = r if cycle.retract_to_r or old < r else old
-    # rs274 compares in the program's units a position it keeps in mm: in an
-    # inch program a tool sitting at R after a cycle reads as just below R
-    # (2.54 / 25.4 < 0.1), so the next block starts with a zero-length rapid.
-    below_r = old / scale[axis] < (old / scale[axis] + cycle.r_words if incremental else cycle.r_words)
+    below_r = old < r
     to_machine = offset[axis]
     steps: list[Step] = []
     here = position.copy()
@@ -124,6 +128,8 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
             if word in params:
                 target[ax] = target[ax] + params[word] * scale[ax] if incremental else params[word] * scale[ax]
         here[[a, b]] = target[[a, b]] + offset[[a, b]]  # rs274 emits it even when already there
+        if not cycle.retract_to_r:  # G98: over the hole at the clear height (up from R after a G99 block)
+            here[axis] = clear + to_machine
         steps.append(Step(here.copy(), MOTION_RAPID))
         if here[axis] != r + to_machine:
             go(r, MOTION_RAPID)

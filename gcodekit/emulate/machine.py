@@ -91,6 +91,7 @@ class Machine:
         self.state = MachineState()
         self.state.units = 25.4 if initial_units == "inch" else 1.0
         self.state.e_relative = initial_extrusion == "relative"
+        self.state.cycle.retract_to_r = config.cycle_retract == "r"
         if config.initial_feed > 0:
             self.state.feed = config.initial_feed
         for code, vector in config.work_offsets.items():
@@ -152,6 +153,7 @@ class Machine:
         if cursor < n and not self.state.ended:
             self._run_segment(table, cursor, n, out)
             cursor = n
+        self.modal.cycle_mode_open = bool(n) and int(table.motion[-1]) == MOTION_CYCLE
         if cursor < n:
             self._hold(cursor, n, out)
             self._once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")

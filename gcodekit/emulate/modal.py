@@ -69,6 +69,7 @@ class ModalHandler:
         self._last_dwell = 0.0  # dwell at the end of a canned cycle's last move
         self._tool_change_line = -1  # source line of the last M6 (see tool length offsets)
         self.splines = SplineBlocks(machine.config.spline_tolerance)
+        self.cycle_mode_open = False  # the last chunk ended in a canned-cycle mode
 
     @property
     def state(self) -> MachineState:
@@ -95,6 +96,8 @@ class ModalHandler:
             self.machine.diagnostics.report(line, 1, "the program zero may not change while polar coordinates (G16) "
                                             "are on", kind="machine")
         if moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
+            if not (int(t.motion[row - 1]) == MOTION_CYCLE if row else self.cycle_mode_open):
+                s.cycle.initial = None  # the cycle mode begins here
             motion, extra = self._cycle(name, params, line)
         elif moves and int(t.motion[row]) == MOTION_THREAD:
             rate = self._thread(params, line)

@@ -30,6 +30,7 @@ _CHOICES = {
     "home_mode": ("stored", "select"),
     "tool_change_on": ("M6", "T"),
     "tool_table_units": ("mm", "inch"),
+    "cycle_retract": ("initial", "r"),
 }
 
 
@@ -95,6 +96,9 @@ class MachineConfig:
         The planner's settings (the ``[planner]`` table), e.g. ``max_accel``.
     spline_tolerance : float
         mm; the chords that follow a G5/G5.1/G5.2 curve stay this close to it.
+    cycle_retract : {"initial", "r"}
+        Where canned cycles retract before a program says G98 or G99: the
+        initial level (G98) or the R plane (G99, rs274's own default).
     """
 
     name: str
@@ -124,6 +128,7 @@ class MachineConfig:
     planner: str = ""
     planner_settings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
     spline_tolerance: float = 0.001
+    cycle_retract: str = "initial"
 
     def __hash__(self) -> int:
         return hash(self.name)

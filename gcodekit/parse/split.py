@@ -143,7 +143,8 @@ def _split_modal(words, flavor):
         rest[letter] = value
     named = [(code_name(flavor, l, v), l, v) for l, v in codes]
     motion = [n for n in named if n[0] in MOTIONS]
-    if len(motion) > 1:
+    if len(motion) > 1 and not (len(motion) == 2 and "cancel_cycle" in (motion[0][0], motion[1][0])):
+        # rs274 takes "G80 G0": the G80 only says what the G0 does anyway
         problems.append("more than one motion code in the block; the last is used")
     g53 = [n for n in named if n[0] == "machine_coordinates"]
     parts: list[tuple[int, Part]] = []
