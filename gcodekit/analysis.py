@@ -24,12 +24,20 @@ if TYPE_CHECKING:
     from .emulate.operation import Operation
 
 
-def depositing(w: dict) -> np.ndarray:
-    """Waypoints that lay material: filament pushed on a move (FFF, LFAM), or a
-    feed move with the heat source on (DED, where the wire or powder has no E)."""
+def depositing(w: dict, screw: bool = False) -> np.ndarray:
+    """Waypoints that lay material: filament pushed on a move (FFF), a feed
+    move with the heat source on (DED, where the wire or powder has no E), or
+    with ``screw``, a feed move while the screw extruder turns (BAAM, CEAD)."""
     moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
-    welding = (np.asarray(w["laser"]) == 1) & (np.asarray(w["motion"]) >= 2) if "laser" in w else False
-    return moving & ((np.asarray(w["de"]) > 0) | welding)
+    feeding = np.asarray(w["motion"]) >= 2
+    welding = (np.asarray(w["laser"]) == 1) & feeding if "laser" in w else False
+    turning = (np.asarray(w["spindle"]) > 0) & feeding if screw else False
+    return moving & ((np.asarray(w["de"]) > 0) | welding | turning)
+
+
+def screw_extruder(op: "Operation") -> bool:
+    """Whether the operation's machine deposits with a screw extruder."""
+    return op.machine is not None and op.machine.extruder == "screw"
 
 
 def operation_statistics(op: "Operation") -> dict[str, Any]:
@@ -37,7 +45,7 @@ def operation_statistics(op: "Operation") -> dict[str, Any]:
     w = op.waypoints
     motion, distance, de = w["motion"], w["distance"], w["de"]
     moving = motion > 0
-    extruding = depositing(w)
+    extruding = depositing(w, screw_extruder(op))
     stats: dict[str, Any] = {
         "lines": op.n_lines,
         "commands": len(op.table),
@@ -58,7 +66,7 @@ def operation_statistics(op: "Operation") -> dict[str, Any]:
         "bounds": op.get_bounds(),
     }
     if op.machine is not None and op.machine.process == "additive":
-        stats["filament_mm"] = float(de.sum())
+        stats["filament_mm"] = None if screw_extruder(op) else float(de.sum())  # pellets: no filament
         stats["layers"] = count_layers(op)
     else:
         stats["filament_mm"] = None
@@ -82,7 +90,7 @@ def count_layers(op: "Operation") -> int:
         if count:
             return count
     w = op.waypoints
-    extruding = depositing(w)
+    extruding = depositing(w, screw_extruder(op))
     return int(np.unique(np.round(w["z"][extruding], 4)).size)
 
 
@@ -136,7 +144,7 @@ def layers(op: "Operation") -> np.ndarray:
     if (marks >= 0).any():
         return marks[waypoint_rows(op)]
     w = op.waypoints
-    extruding = depositing(w)
+    extruding = depositing(w, screw_extruder(op))
     z = np.round(np.asarray(w["z"]), 4)
     new_layer = extruding & (z != np.r_[np.nan, z[:-1]])
     starts = np.flatnonzero(new_layer)

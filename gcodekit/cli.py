@@ -158,7 +158,8 @@ def _text(r: dict[str, Any]) -> str:
         + (f"(planned like {r['planner']})" if r["planner"] else "(length / feed: no planner for this machine)"),
     ]
     if r["layers"] is not None:
-        lines.append(f"  layers     {r['layers']}   filament {r['filament_mm']:.1f} mm")
+        filament = f"   filament {r['filament_mm']:.1f} mm" if r["filament_mm"] is not None else ""
+        lines.append(f"  layers     {r['layers']}{filament}")
     if r["tools"]:
         lines.append(f"  tools      {' '.join(map(str, r['tools']))}")
     diags = r["diagnostics"]

@@ -51,6 +51,13 @@ _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTR
 _MILL = np.array([Kind.MILL, Kind.MOVE_MILL, Kind.ARC_MILL], np.uint8)
 
 
+def _held(values: np.ndarray, before: float) -> np.ndarray:
+    """Each row's last given value (NaN means none given), ``before`` until the first."""
+    known = ~np.isnan(values)
+    last = np.maximum.accumulate(np.where(known, np.arange(values.size), -1))
+    return np.where(last >= 0, values[np.maximum(last, 0)], before)
+
+
 def mode_rows(table: CommandTable, on: str, off: str, initially: bool = False) -> np.ndarray:
     """Which rows run while the modal switch ``on`` (not yet ``off``) is in force, in table order."""
     switches = np.full(len(table), -1, np.int8)
@@ -99,9 +106,32 @@ class Machine:
         self.tools = ToolTable.read(config.tool_table, units=config.tool_table_units) if config.tool_table else ToolTable()
         self.modal = ModalHandler(self)
         self._straight_ids = np.array([NAME_ID["rapid"], NAME_ID["linear"]], np.uint8)
+        self._table_z, self._table_w = np.nan, 0.0  # last Z and table-axis words (see _part_frame)
         self._warned: set[str] = set()
 
     # -- running ----------------------------------------------------------------
+
+    def _part_frame(self, table: CommandTable) -> CommandTable:
+        """The table as the part sees it when a table axis carries it (BAAM's W): Z words become Z - W.
+
+        Both are absolute positions held between blocks, so a block with
+        only W (the table dropping a layer) moves the tool up in the part
+        frame, and one with only Z moves by Z less the table's height.  Table
+        moves before the program's first Z leave the tool's height alone.
+        """
+        axis = self.config.table_axis
+        if not axis:
+            return table
+        z, w = table.param("Z"), table.param(axis)
+        given = ~np.isnan(z) | ~np.isnan(w)
+        if not given.any():
+            return table
+        z_held = _held(z, self._table_z)  # NaN until the program first gives Z: the table moves alone
+        w_held = _held(w, self._table_w)
+        self._table_z, self._table_w = float(z_held[-1]), float(w_held[-1])
+        params = {k: v for k, v in table.params.items() if k != axis}
+        params["Z"] = np.where(given, z_held - w_held, np.nan)
+        return dataclasses.replace(table, params=params)
 
     def _radius_words(self, table: CommandTable) -> CommandTable:
         """The table as the machine reads it under G7: X words halved (diameters to radii).
@@ -126,7 +156,7 @@ class Machine:
         :data:`SMALL_COLUMNS` arrays and ``command`` (row of the command each
         waypoint belongs to) when some command added waypoints.
         """
-        table = self._radius_words(table)
+        table = self._part_frame(self._radius_words(table))
         n = len(table)
         out = {k: np.empty(n) for k in FLOAT_COLUMNS}
         out.update({k: np.empty(n, dtype) for k, (dtype, _) in SMALL_COLUMNS.items()})

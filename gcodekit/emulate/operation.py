@@ -381,10 +381,17 @@ class AdditiveOperation(Operation):
 
     def _process_fields(self, k: int) -> dict[str, Any]:
         fields = super()._process_fields(k)
-        volume = float(self.waypoints["de"][k]) * self.filament_area
+        w = self.waypoints
+        screw = self.machine is not None and self.machine.extruder == "screw"
+        if screw:  # rpm x minutes x cm^3 per revolution, while the screw turns on a feed move
+            turning = w["spindle"][k] > 0 and w["motion"][k] >= 2
+            per_rev = self.machine.screw_displacement * 1000.0 or np.nan  # mm^3; unknown when not given
+            volume = float(w["spindle"][k] * np.nan_to_num(w["time"][k]) / 60.0 * per_rev) if turning else 0.0
+        else:
+            volume = float(w["de"][k]) * self.filament_area
         distance = fields["distance"]
         fields.update(deposited_volume=volume, bead_area=volume / distance if distance > 0 and volume > 0 else 0.0,
-                      extruder_type="filament")
+                      extruder_type="screw" if screw else "filament")
         return fields
 
 

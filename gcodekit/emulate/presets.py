@@ -31,6 +31,8 @@ _CHOICES = {
     "tool_change_on": ("M6", "T"),
     "tool_table_units": ("mm", "inch"),
     "cycle_retract": ("initial", "r"),
+    "table_axis": ("", "W"),
+    "extruder": ("filament", "screw"),
 }
 
 
@@ -99,6 +101,16 @@ class MachineConfig:
     cycle_retract : {"initial", "r"}
         Where canned cycles retract before a program says G98 or G99: the
         initial level (G98) or the R plane (G99, rs274's own default).
+    table_axis : {"", "W"}
+        An axis that moves the build table up and down (BAAM's W): the part
+        frame's height is then Z - W, so a table drop between layers is a
+        layer change.  Absolute positioning only.
+    extruder : {"filament", "screw"}
+        What deposits: filament pushed by E, or a screw extruder (BAAM,
+        CEAD) turning at the spindle speed S while the spindle is on (M3).
+    screw_displacement : float
+        cm^3 of material a screw extruder delivers per revolution; 0 leaves
+        its deposited volume unknown (NaN).
     """
 
     name: str
@@ -129,6 +141,9 @@ class MachineConfig:
     planner_settings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
     spline_tolerance: float = 0.001
     cycle_retract: str = "initial"
+    table_axis: str = ""
+    extruder: str = "filament"
+    screw_displacement: float = 0.0
 
     def __hash__(self) -> int:
         return hash(self.name)

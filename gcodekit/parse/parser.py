@@ -346,6 +346,9 @@ class GcodeParser:
                 # the dialect's list is complete: LinuxCNC stops here (convert_g / convert_m)
                 self.diagnostics.report(line, 1, f"Unknown {code[0].lower()} code used: {code} "
                                         f"is not a {self.flavor.name} code", kind="machine")
+            elif code in self.flavor.other_codes:
+                self.diagnostics.warn(line, 1, f"{code} is a {self.flavor.name} code gcodekit does not emulate; "
+                                      "kept as a generic command")
             else:
                 self.diagnostics.warn(line, 1, f"{code} is not a {self.flavor.name} code; kept as a generic command")
 

@@ -29,7 +29,7 @@ import numpy as np
 from ...errors import ConfigError, check_choice
 from ...parse.table import NAME_ID
 from .. import arcs
-from ..motion import MotionProfile
+from ..motion import BAAMMotionProfile, MotionProfile
 from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
 
 if TYPE_CHECKING:
@@ -64,6 +64,11 @@ class MotionProfileConfig:
         mm/s^3, for ``"scurve"``; None: full acceleration after 0.1 s.
     arc_resolution : float
         mm, longest chord an arc is cut into.
+    machine_rules : {"", "baam"}
+        ``"baam"`` plans with :class:`~gcodekit.emulate.motion.BAAMMotionProfile`
+        (rest before and after each layer change, per-axis speed caps).
+    axis_max_velocity : list of 3 floats or None
+        mm/s, X, Y and Z speed caps for ``"baam"``.
     """
 
     max_acceleration: float | None = None
@@ -72,9 +77,12 @@ class MotionProfileConfig:
     profile_type: str = "trapezoid"
     max_jerk: float | None = None
     arc_resolution: float = 1.0
+    machine_rules: str = ""
+    axis_max_velocity: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         check_choice("profile_type", self.profile_type, PROFILE_TYPES)
+        check_choice("machine_rules", self.machine_rules, ("", "baam"))
         for key in ("max_acceleration", "max_velocity", "max_jerk", "arc_resolution"):
             value = getattr(self, key)
             if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float)) or value <= 0):
@@ -90,8 +98,12 @@ class MotionProfileConfig:
 
     def motion_profile(self) -> MotionProfile:
         """The :class:`MotionProfile` these settings describe."""
-        profile = MotionProfile(self.max_acceleration, self.max_velocity, self.junction_deviation,
-                                max_jerk=self.max_jerk)
+        if self.machine_rules == "baam":
+            profile = BAAMMotionProfile(self.max_acceleration, self.max_velocity, self.junction_deviation,
+                                        max_jerk=self.max_jerk, axis_max_velocity=self.axis_max_velocity)
+        else:
+            profile = MotionProfile(self.max_acceleration, self.max_velocity, self.junction_deviation,
+                                    max_jerk=self.max_jerk)
         profile.profile_type = self.profile_type
         return profile
 

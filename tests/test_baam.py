@@ -1,0 +1,61 @@
+"""Cincinnati BAAM programs (ORNL Slicer 2's Cincinnati syntax): screw extruder, W table, layers, planning.
+
+Expected values are worked out by hand from examples/baam_wall.nc: a 20 x 10 in
+rectangle, two layers of 0.2 in, at 600 in/min, the screw at 110 then 120 rpm.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gcodekit
+from gcodekit import analysis
+
+WALL = Path(__file__).parents[1] / "examples" / "baam_wall.nc"
+INCH = 25.4
+
+
+def test_detected_from_the_slicer_header():
+    op = gcodekit.gcode_to_operation(WALL)
+    assert (op.flavor.name, op.machine.name) == ("baam", "baam")
+
+
+def test_the_w_table_drop_is_a_layer_change_in_the_part_frame():
+    op = gcodekit.gcode_to_operation(WALL)
+    w = op.waypoints
+    printing = analysis.depositing(w, screw=True)
+    # Z30.2 with the table at W30 is 0.2 in above the table; W29.8 lowers the table 0.2 in more
+    assert np.unique(np.round(w["z"][printing], 6)).tolist() == [pytest.approx(0.2 * INCH), pytest.approx(0.4 * INCH)]
+    assert op.get_statistics()["layers"] == 2  # "M1 (OPTIONAL STOP - LAYER CHANGE)" before each layer
+    assert set(analysis.features(op)[printing]) == {"PERIMETER"}
+
+
+def test_the_screw_deposits_on_feed_moves_while_it_turns():
+    op = gcodekit.gcode_to_operation(WALL, screw_displacement=2.0)
+    stats = op.get_statistics()
+    assert stats["moves"]["extruding"] == 8
+    assert stats["distance_mm"]["extrude"] == pytest.approx(2 * 60 * INCH)  # two 60 in perimeters
+    volumes = [p.deposited_volume for p in op.process_data if p.motion == "feed"]
+    # 20 in at 600 in/min is 2 s; 110 rpm for 2 s is 3.667 rev of 2 cm^3
+    assert volumes[0] == pytest.approx(110 * 2 / 60 * 2.0 * 1000)
+    assert volumes[4] == pytest.approx(120 * 2 / 60 * 2.0 * 1000)  # S120 on the second layer
+    unknown = gcodekit.gcode_to_operation(WALL)  # no displacement in the preset: unknown, not zero
+    assert np.isnan(unknown.process_data[18].deposited_volume)
+
+
+def test_planner_stops_before_and_after_the_layer_change():
+    # the screw keeps turning through the table drop, so only BAAM's rule makes the machine stop there
+    text = ("(Cincinnati)\nG0 W30\nG0 X0 Y0 Z30.2\nM3 S100\nG1 F600 X20\nY10\nG1 W29.8\nG1 X0\nY0\nM5\nM30\n")
+    rules = {"max_acceleration": 500.0, "max_velocity": 1000.0}
+    op = gcodekit.gcode_to_operation(text, "baam", planner_settings={"machine_rules": "baam", **rules})
+    moves, result = op.plan
+    z = np.round(op.waypoints["z"][moves.waypoint], 6)
+    change = int(np.flatnonzero(np.diff(z) > 0)[-1]) + 1  # the move up to the second layer
+    assert result.end_v[change - 1] == 0.0 and result.start_v[change] == 0.0 and result.end_v[change] == 0.0
+    free = gcodekit.gcode_to_operation(text, "baam", planner_settings=rules)
+    _, free_result = free.plan
+    assert free_result.end_v[change - 1] > 0.0  # a plain corner otherwise
+    assert free.get_statistics()["time_s"] < op.get_statistics()["time_s"]  # the stops cost time
