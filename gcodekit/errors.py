@@ -97,6 +97,7 @@ class Diagnostics:
         self.limit = limit
         self.items: list[Diagnostic] = []
         self.dropped = 0
+        self._first_error: tuple[str, Diagnostic] | None = None  # (kind, diagnostic), for raise_first
 
     def report(
         self,
@@ -112,6 +113,8 @@ class Diagnostics:
         diag = Diagnostic(self.file, int(line), int(column), severity, message, text)
         if self.mode == "strict" and severity == "error":
             raise _ERROR_TYPES[kind](message, diag)
+        if severity == "error" and self._first_error is None:
+            self._first_error = (kind, diag)
         if len(self.items) < self.limit:
             self.items.append(diag)
         else:
@@ -124,6 +127,17 @@ class Diagnostics:
     def extend(self, diagnostics: Iterable[Diagnostic]) -> None:
         for d in diagnostics:
             self.report(d.line, d.column, d.message, d.text, severity=d.severity)
+
+    @property
+    def has_error(self) -> bool:
+        """Whether an error has been recorded (cheap: for checks on every line)."""
+        return self._first_error is not None
+
+    def raise_first(self) -> None:
+        """Raise the first error recorded (as strict mode would have), if any."""
+        if self._first_error is not None:
+            kind, diag = self._first_error
+            raise _ERROR_TYPES[kind](diag.message, diag)
 
     @property
     def errors(self) -> list[Diagnostic]:

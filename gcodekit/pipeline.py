@@ -231,6 +231,15 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
             if lines and lines[-1] == "":
                 lines.pop()
             source = (SourceLine(t.rstrip("\r"), k + 1, program.name) for k, t in enumerate(lines))
+            if diagnostics.mode == "strict":
+                # The interpreter runs a line at a time: a line before the first
+                # preprocess error, in execution order, may fail first.
+                early = Diagnostics(diagnostics.file, "lenient")
+                out = _until_first_error(run_stages(source, stages, early), early)
+                yield read_source_lines(out, flavor, diagnostics), len(lines)
+                diagnostics.extend(d for d in early if d.severity != "error")
+                early.raise_first()
+                return
             out = run_stages(source, stages, diagnostics)
             yield read_source_lines(out, flavor, diagnostics), len(lines)
             return
@@ -248,6 +257,14 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
 
     for blocks in iter_blocks(counted(), flavor, diagnostics):
         yield blocks, sizes[-1]
+
+
+def _until_first_error(lines: Iterator, diagnostics: Diagnostics) -> Iterator:
+    """``lines`` up to, not including, the one being made when ``diagnostics`` first got an error."""
+    for line in lines:
+        if diagnostics.has_error:
+            return
+        yield line
 
 
 def _progress(program: Program, enabled: bool):

@@ -43,8 +43,6 @@ FILE_ENDED = "File ended with no percent sign"
 
 #: rs274 messages whose cause gcodekit does not emulate at all.
 SKIP = {
-    "Named parameter #<_hal[": "HAL pins (rs274 standalone has no HAL)",
-    "Unknown m code used: M1": "user M-code M100-M199 (an external program of the machine)",
 }
 
 #: Programs gcodekit knows it does not refuse yet, and why.
