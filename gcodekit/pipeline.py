@@ -28,6 +28,7 @@ from .emulate.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine
 from .errors import ConfigError, Diagnostics, check_choice
 from .parse import CommandTable, GcodeParser
+from .parse.table import NAME_ID
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
 from .syntax import Flavor, detect_flavor, load_flavor
 
@@ -47,6 +48,7 @@ class Program:
     name: str
     path: Path | None = None
     text: str | None = None
+    preprocessed: bool = False  # the preprocess stage ran (and checked how the file ends)
 
     def chunks(self) -> Iterator[bytes]:
         return iter_lines(self.path if self.path is not None else self.text)
@@ -193,6 +195,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     table = CommandTable.concat(tables) if tables else _empty_table(parser, program)
     if not tables:
         waypoints, sizes = [m.run(table)], [0]
+    if fl.percent_delimiter and program.path is not None and not program.preprocessed:
+        _check_program_end(program, table, n_lines, diagnostics)
     op = cls(table, _concat_waypoints(waypoints, sizes), file=program.name,
              flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
     from .emulate.compensation import compensate, uses_compensation
@@ -227,6 +231,7 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
             needs_parameters(text) or _O_WORD_LINE.search(text)) else []
         stages += [WizardStage(flavor)] if flavor.wizards and needs_wizards(text) else []
         if stages:
+            program.preprocessed = True
             lines = text.split("\n")
             if lines and lines[-1] == "":
                 lines.pop()
@@ -257,6 +262,24 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
 
     for blocks in iter_blocks(counted(), flavor, diagnostics):
         yield blocks, sizes[-1]
+
+
+def _check_program_end(program: Program, table: CommandTable, n_lines: int, diagnostics: Diagnostics) -> None:
+    """A program file must end with M2/M30 or be wrapped in ``%`` lines (rs274's ``read_text``,
+    interp_read.cc); the error names the file's last line."""
+    if (table.name == NAME_ID["program_end"]).any() or n_lines == 0:
+        return
+    marks = []
+    for k, raw in enumerate(b"".join(program.chunks()).splitlines()):
+        stripped = raw.strip()
+        if stripped == b"%":
+            marks.append(k)
+        elif stripped and not marks:
+            break  # text before any '%': the program is not wrapped
+    if len(marks) >= 2:
+        return
+    diagnostics.report(n_lines, 1, "File ended with no percent sign" + (" or program end (M2 or M30)" * (not marks)),
+                       kind="machine")
 
 
 def _until_first_error(lines: Iterator, diagnostics: Diagnostics) -> Iterator:

@@ -47,8 +47,6 @@ SKIP = {
 
 #: Programs gcodekit knows it does not refuse yet, and why.
 KNOWN_GAPS = {
-    "nc_files/ngcgui_lib/utilitysubs/bye.ngc": "missing program end found only by the control-flow stage, "
-                                               "which runs on programs with O-words or parameters",
 }
 
 
