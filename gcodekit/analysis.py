@@ -58,10 +58,14 @@ def operation_statistics(op: "Operation") -> dict[str, Any]:
         "bounds": op.get_bounds(),
     }
     if op.machine is not None and op.machine.process == "additive":
-        stats["filament_mm"] = float(de.sum())
+        from .additive.filament import filament_used, slicer_convention
+
+        stats["filament_mm"] = filament_used(op)
+        stats["filament_convention"] = slicer_convention(op)
+        stats["filament_pushed_mm"] = float(de.sum())
         stats["layers"] = count_layers(op)
     else:
-        stats["filament_mm"] = None
+        stats["filament_mm"] = stats["filament_convention"] = stats["filament_pushed_mm"] = None
         stats["layers"] = None
     return stats
 
@@ -121,25 +125,28 @@ def features(op: "Operation") -> np.ndarray:
     return names[marks[waypoint_rows(op)] + 1]
 
 
-def layers(op: "Operation") -> np.ndarray:
+def layers(op: "Operation", heights: np.ndarray | None = None) -> np.ndarray:
     """Layer number (0-based) of each waypoint, -1 before the first layer.
 
-    From the flavor's layer-change comments when the program has them; else a
-    new layer starts at each new Z height reached by an extruding move.
+    From the flavor's layer-change comments when the program has them and no
+    ``heights`` are given; else a new layer starts at each new height reached
+    by a depositing move.  ``heights`` (mm, one per waypoint) default to Z;
+    pass the positions projected on another layer normal for tilted layers.
     """
-    marks = np.full(len(op.table), -1, np.int64)
-    for pattern in (op.flavor.layer_comments if op.flavor else ()):
-        found, labels = _row_labels(op, f"({pattern})")
-        if labels:
-            marks = found
-            break
-    if (marks >= 0).any():
-        return marks[waypoint_rows(op)]
-    w = op.waypoints
-    extruding = depositing(w)
-    z = np.round(np.asarray(w["z"]), 4)
-    new_layer = extruding & (z != np.r_[np.nan, z[:-1]])
-    starts = np.flatnonzero(new_layer)
+    if heights is None:
+        marks = np.full(len(op.table), -1, np.int64)
+        for pattern in (op.flavor.layer_comments if op.flavor else ()):
+            found, labels = _row_labels(op, f"({pattern})")
+            if labels:
+                marks = found
+                break
+        if (marks >= 0).any():
+            return marks[waypoint_rows(op)]
+        heights = op.waypoints["z"]
+    extruding = np.flatnonzero(depositing(op.waypoints))
+    z = np.round(np.asarray(heights, float), 4)
+    at = z[extruding]
+    starts = extruding[np.r_[True, at[1:] != at[:-1]]] if extruding.size else extruding
     # a layer begins at its first extruding move; heights already printed are not new
     seen = np.unique(z[starts], return_index=True)[1]
     first = np.zeros(z.size, bool)

@@ -383,8 +383,9 @@ class AdditiveOperation(Operation):
         fields = super()._process_fields(k)
         volume = float(self.waypoints["de"][k]) * self.filament_area
         distance = fields["distance"]
+        extruder = self.machine.extruder_type if self.machine else "filament"
         fields.update(deposited_volume=volume, bead_area=volume / distance if distance > 0 and volume > 0 else 0.0,
-                      extruder_type="filament")
+                      extruder_type=extruder)
         return fields
 
 

@@ -30,6 +30,7 @@ _CHOICES = {
     "home_mode": ("stored", "select"),
     "tool_change_on": ("M6", "T"),
     "tool_table_units": ("mm", "inch"),
+    "extruder_type": ("filament", "screw", "wire", "powder"),
 }
 
 
@@ -74,6 +75,9 @@ class MachineConfig:
         mm; turns extruded length into volume.
     filament_density : float
         g/cm^3; turns volume into mass.
+    extruder_type : {"filament", "screw", "wire", "powder"}
+        How material reaches the bead: filament drive (FFF), pellet screw
+        (LFAM), wire or powder feed (DED).
     work_offsets : mapping of str to list of float
         Initial G54-G59.3 offsets in mm, e.g. ``G55 = [100, 0, 0]``.
     retract_length, unretract_extra_length : float
@@ -111,6 +115,7 @@ class MachineConfig:
     block_delete: bool = False
     filament_diameter: float = 1.75
     filament_density: float = 1.24
+    extruder_type: str = "filament"
     work_offsets: Mapping[str, tuple[float, ...]] = field(default_factory=lambda: MappingProxyType({}))
     retract_length: float = 0.0
     retract_speed: float = 20.0
