@@ -18,6 +18,7 @@ from .emulate.operation import (
     SubtractiveProcessData,
 )
 from .additive import AdditivePart, Bead, VTKExporter
+from . import visualize
 from .analysis import export_event_series_from_gcode, gcode_dataframe_to_event_series
 from .emulate.exporters import GcodeExporter
 from .emulate.presets import MachineConfig, list_machines, load_machine

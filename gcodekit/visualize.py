@@ -1,0 +1,266 @@
+"""Output stage: pictures of an operation, 3D with PyVista and 2D layers with matplotlib.
+
+Both libraries load on first use.  3D pictures render off-screen through EGL
+unless ``VTK_DEFAULT_OPENGL_WINDOW`` says otherwise, so they work on a machine
+without a display.
+
+Examples
+--------
+::
+
+    op = gcodekit.gcode_to_operation("part.gcode")
+    gcodekit.visualize.plot_operation(op, scalars="speed", screenshot="part.png")
+    gcodekit.visualize.plot_layer(op, 10).figure.savefig("layer10.png")
+"""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .errors import check_choice
+
+if TYPE_CHECKING:
+    import pyvista as pv
+    from matplotlib.axes import Axes
+
+    from .additive.part import AdditivePart
+    from .emulate.operation import Operation
+
+CAMERAS = ("iso", "top", "front", "side")
+#: Scalars with a meaning beyond a waypoint column, and the colour-bar title of each.
+NAMED_SCALARS = {"feature": "feature", "speed": "speed (mm/s)", "layer": "layer", "time": "elapsed time (s)",
+                 "feed": "feed (mm/min)", "tool": "tool", "laser": "heat source on"}
+_TRAVEL_COLOR = "#9a9a9a"
+_MAX_GLYPHS = 300
+
+
+def _is_additive(op: "Operation") -> bool:
+    return op.machine is not None and op.machine.process == "additive"
+
+
+def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
+    """Waypoints that are the work and the rest of the moves.
+
+    The work is the depositing moves from the first layer on (start-code purge
+    lines are not the part) or, for a mill, the feed moves.
+    """
+    from .analysis import depositing, layers
+
+    w = op.waypoints
+    moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
+    moving[0] = False  # a move is drawn from the waypoint before it
+    if _is_additive(op):
+        work = depositing(w) & (layers(op) >= 0)
+    else:
+        work = np.asarray(w["motion"]) >= 2
+    work &= moving
+    return work, moving & ~work
+
+
+def waypoint_scalars(op: "Operation", scalars: str) -> tuple[np.ndarray, list[str] | None]:
+    """Values of ``scalars`` at every waypoint, and category names for a categorical one.
+
+    ``feature`` (slicer ``;TYPE:`` or DED fraction comments), ``speed`` (each
+    move's length over its planned time, mm/s), ``layer``, ``time`` (elapsed,
+    s), or any waypoint column (``feed``, ``tool``, ``laser``, ``z`` ...).
+    """
+    from . import analysis
+
+    w = op.waypoints
+    if scalars == "feature":
+        names, codes = np.unique(analysis.features(op).astype(str), return_inverse=True)
+        return codes.astype(np.int32), [n or "(none)" for n in names.tolist()]
+    if scalars == "speed":
+        d, t = np.asarray(w["distance"], float), np.nan_to_num(np.asarray(w["time"], float))
+        return np.divide(d, t, out=np.zeros_like(d), where=t > 0), None
+    if scalars == "layer":
+        return analysis.layers(op), None
+    if scalars in ("time", "elapsed_time"):
+        return op.elapsed_time(), None
+    check_choice("scalars", scalars, [*NAMED_SCALARS, *sorted(k for k in w if k != "command")])
+    return np.asarray(w[scalars]), None
+
+
+def _lines(pv, xyz: np.ndarray, rows: np.ndarray) -> "pv.PolyData":
+    """One two-point line cell per move, sharing the waypoint points (move ``i`` runs ``i-1 -> i``)."""
+    cells = np.column_stack([np.full(rows.size, 2), rows - 1, rows]).ravel()
+    mesh = pv.PolyData(xyz, lines=cells)
+    return mesh
+
+
+def operation_polydata(op: "Operation", scalars: str = "feature") -> tuple["pv.PolyData", "pv.PolyData", list | None]:
+    """The work moves (with ``scalars`` as cell data) and the travel moves of ``op`` as line meshes."""
+    from .additive.vtk import import_pyvista
+
+    pv = import_pyvista()
+    w = op.waypoints
+    xyz = np.column_stack([np.asarray(w[k], float) for k in "xyz"])
+    work, travel = move_masks(op)
+    values, categories = waypoint_scalars(op, scalars)
+    work_rows = np.flatnonzero(work)
+    mesh = _lines(pv, xyz, work_rows)
+    values = values[work_rows]
+    if categories is not None:  # keep the categories the drawn moves have
+        used, values = np.unique(values, return_inverse=True)
+        categories = [categories[k] for k in used]
+    mesh.cell_data[scalars] = values
+    a, b = np.asarray(w["a"], float), np.asarray(w["b"], float)
+    if np.any(a != 0) or np.any(b != 0):
+        from .analysis import tool_vectors
+
+        mesh.cell_data["tool_vector"] = tool_vectors(a[work_rows], b[work_rows])
+    return mesh, _lines(pv, xyz, np.flatnonzero(travel)), categories
+
+
+def _glyphs(pv, mesh: "pv.PolyData", size: float) -> "pv.PolyData":
+    """Arrows along the tool direction at up to ``_MAX_GLYPHS`` moves."""
+    centers = mesh.cell_centers()
+    step = max(1, centers.n_points // _MAX_GLYPHS)
+    picked = pv.PolyData(centers.points[::step])
+    picked["tool_vector"] = mesh.cell_data["tool_vector"][::step]
+    return picked.glyph(orient="tool_vector", scale=False, factor=size, geom=pv.Arrow())
+
+
+def plot_operation(op: "Operation", scalars: str = "feature", *, show_travel: bool = False,
+                   tool_vectors: bool = False, off_screen: bool = True, screenshot: str | os.PathLike | None = None,
+                   camera: str = "iso", window_size: tuple[int, int] = (1200, 900), line_width: float = 2.0,
+                   cmap: str | None = None, background: str = "white") -> np.ndarray | None:
+    """Draw the toolpath of an emulated operation in 3D with PyVista.
+
+    Parameters
+    ----------
+    op : Operation
+    scalars : str, default: "feature"
+        Colour by ``feature``, ``speed``, ``layer``, ``time`` or any waypoint
+        column (see :func:`waypoint_scalars`).
+    show_travel : bool, default: False
+        Also draw the moves that lay no material (rapids for a mill), grey.
+    tool_vectors : bool, default: False
+        Arrows along the head direction (5-axis DED programs).
+    off_screen : bool, default: True
+        Render without a window; False opens an interactive one.
+    screenshot : path, default: None
+        Write a PNG of the picture there.
+    camera : {"iso", "top", "front", "side"}, default: "iso"
+
+    Returns
+    -------
+    The image as an (height, width, 3) array when off-screen, else None.
+    """
+    check_choice("camera", camera, CAMERAS)
+    if not _is_emulated(op):
+        raise ValueError(f"{op.file}: plot_operation needs an emulated operation (use gcode_to_operation)")
+    from .additive.vtk import import_pyvista
+
+    pv = import_pyvista()
+    mesh, travel, categories = operation_polydata(op, scalars)
+    if mesh.n_cells == 0 and (travel.n_cells == 0 or not show_travel):
+        raise ValueError(f"{op.file}: nothing to draw (no {'deposition' if _is_additive(op) else 'feed'} moves)")
+    plotter = pv.Plotter(off_screen=off_screen, window_size=list(window_size))
+    plotter.set_background(background)
+    bar: dict[str, Any] = dict(title=NAMED_SCALARS.get(scalars, scalars), color="black", vertical=True,
+                               position_x=0.88, position_y=0.1, height=0.8, width=0.04,
+                               title_font_size=18, label_font_size=14,
+                               fmt="%.0f" if mesh[scalars].dtype.kind in "iu" else "%.4g")
+    kwargs: dict[str, Any] = dict(scalars=scalars, line_width=line_width, scalar_bar_args=bar,
+                                  cmap=cmap or ("tab10" if categories else "viridis"))
+    if categories:
+        if len(categories) > 10 and cmap is None:
+            kwargs["cmap"] = "tab20"
+        kwargs.update(categories=True, clim=[-0.5, len(categories) - 0.5],
+                      annotations={k: name for k, name in enumerate(categories)})
+        bar.update(n_labels=0, n_colors=len(categories))
+    if mesh.n_cells:
+        plotter.add_mesh(mesh, **kwargs)
+    if show_travel and travel.n_cells:
+        plotter.add_mesh(travel, color=_TRAVEL_COLOR, line_width=max(line_width / 2, 1.0), opacity=0.6)
+    if tool_vectors and "tool_vector" in mesh.cell_data:
+        size = 0.04 * float(np.linalg.norm(np.ptp(mesh.points[np.unique(mesh.lines.reshape(-1, 3)[:, 1:])], axis=0)))
+        plotter.add_mesh(_glyphs(pv, mesh, size), color="#d62728")
+    {"iso": plotter.view_isometric, "top": plotter.view_xy, "front": plotter.view_xz,
+     "side": plotter.view_yz}[camera]()
+    _frame(plotter, mesh if mesh.n_cells else travel)
+    if not off_screen:
+        plotter.show()
+        return None
+    image = plotter.screenshot(None if screenshot is None else str(screenshot), return_img=True)
+    plotter.close()
+    return image
+
+
+def _is_emulated(op) -> bool:
+    return getattr(op, "waypoints", None) is not None
+
+
+def _frame(plotter, mesh) -> None:
+    """Fit the camera to the drawn moves only (not the machine's home position)."""
+    used = np.unique(mesh.lines.reshape(-1, 3)[:, 1:])
+    lo, hi = mesh.points[used].min(axis=0), mesh.points[used].max(axis=0)
+    plotter.reset_camera(bounds=[lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]])
+    plotter.camera.zoom(1.05)
+
+
+def plot_layer(source: "Operation | AdditivePart", layer: int, *, ax: "Axes | None" = None,
+               scalars: str = "feature", show_travel: bool = True, line_width: float = 1.2) -> "Axes":
+    """Draw one layer from above with matplotlib: its work moves coloured by ``scalars``, travel dashed.
+
+    Parameters
+    ----------
+    source : Operation or AdditivePart
+    layer : int
+        0-based, as :func:`gcodekit.analysis.layers` numbers them.
+    ax : matplotlib Axes, default: a new figure's
+
+    Returns
+    -------
+    The Axes drawn on.
+    """
+    from matplotlib.collections import LineCollection
+
+    op = getattr(source, "operation", source)
+    if not _is_emulated(op):
+        raise ValueError(f"{op.file}: plot_layer needs an emulated operation (use gcode_to_operation)")
+    from . import analysis
+
+    in_layer = (source.waypoint_layer if hasattr(source, "waypoint_layer") else analysis.layers(op)) == layer
+    work, travel = move_masks(op)
+    if not (work & in_layer).any():
+        raise ValueError(f"{op.file}: layer {layer} has no deposition moves")
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        ax = plt.subplots(figsize=(7, 6))[1]
+    w = op.waypoints
+    xy = np.column_stack([np.asarray(w["x"], float), np.asarray(w["y"], float)])
+
+    def segments(mask):
+        rows = np.flatnonzero(mask)
+        return np.stack([xy[rows - 1], xy[rows]], axis=1), rows
+
+    values, categories = waypoint_scalars(op, scalars)
+    segs, rows = segments(work & in_layer)
+    lines = LineCollection(segs, linewidths=line_width, cmap="tab10" if categories else "viridis")
+    lines.set_array(values[rows].astype(float))
+    if categories:
+        lines.set_clim(-0.5, 9.5)
+    ax.add_collection(lines)
+    if show_travel:
+        tsegs, _ = segments(travel & in_layer)
+        ax.add_collection(LineCollection(tsegs, linewidths=0.5, colors=_TRAVEL_COLOR, linestyles="dashed"))
+    if categories:
+        import matplotlib.lines as mlines
+
+        used = np.unique(values[rows])
+        handles = [mlines.Line2D([], [], color=lines.cmap(lines.norm(k)), label=categories[k]) for k in used]
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
+    else:
+        ax.figure.colorbar(lines, ax=ax, label=NAMED_SCALARS.get(scalars, scalars))
+    ax.autoscale()
+    ax.set_aspect("equal")
+    ax.set_xlabel("X (mm)")
+    ax.set_ylabel("Y (mm)")
+    ax.set_title(f"{os.path.basename(op.file)}: layer {layer}")
+    return ax
