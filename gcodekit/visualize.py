@@ -80,7 +80,7 @@ def waypoint_scalars(op: "Operation", scalars: str) -> tuple[np.ndarray, list[st
         return analysis.layers(op), None
     if scalars in ("time", "elapsed_time"):
         return op.elapsed_time(), None
-    check_choice("scalars", scalars, [*NAMED_SCALARS, *sorted(k for k in w if k != "command")])
+    check_choice("scalars", scalars, [*NAMED_SCALARS, *sorted(k for k in w if k not in NAMED_SCALARS and k != "command")])
     return np.asarray(w[scalars]), None
 
 
@@ -127,7 +127,8 @@ def _glyphs(pv, mesh: "pv.PolyData", size: float) -> "pv.PolyData":
 def plot_operation(op: "Operation", scalars: str = "feature", *, show_travel: bool = False,
                    tool_vectors: bool = False, off_screen: bool = True, screenshot: str | os.PathLike | None = None,
                    camera: str = "iso", window_size: tuple[int, int] = (1200, 900), line_width: float = 2.0,
-                   cmap: str | None = None, background: str = "white") -> np.ndarray | None:
+                   cmap: str | None = None, background: str = "white",
+                   scalar_bar: bool = True) -> np.ndarray | None:
     """Draw the toolpath of an emulated operation in 3D with PyVista.
 
     Parameters
@@ -145,6 +146,8 @@ def plot_operation(op: "Operation", scalars: str = "feature", *, show_travel: bo
     screenshot : path, default: None
         Write a PNG of the picture there.
     camera : {"iso", "top", "front", "side"}, default: "iso"
+    scalar_bar : bool, default: True
+        Draw the colour bar (the legend of a categorical scalar).
 
     Returns
     -------
@@ -166,6 +169,7 @@ def plot_operation(op: "Operation", scalars: str = "feature", *, show_travel: bo
                                title_font_size=18, label_font_size=14,
                                fmt="%.0f" if mesh[scalars].dtype.kind in "iu" else "%.4g")
     kwargs: dict[str, Any] = dict(scalars=scalars, line_width=line_width, scalar_bar_args=bar,
+                                  show_scalar_bar=scalar_bar,
                                   cmap=cmap or ("tab10" if categories else "viridis"))
     if categories:
         if len(categories) > 10 and cmap is None:

@@ -168,7 +168,7 @@ class AdditivePart:
     @property
     def volume(self) -> float:
         """Deposited volume, mm^3: bead area times length, else filament pushed times its section."""
-        return float(self.depositions["volume"].sum())
+        return float(np.sum(self.depositions["volume"].to_numpy()))  # NaN when unknown, not 0
 
     @property
     def density(self) -> float:
