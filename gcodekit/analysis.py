@@ -306,7 +306,7 @@ def gcode_dataframe_to_event_series(df: "pd.DataFrame", source: str = "material"
         ``laser`` for ``source="heat"``).
     source : {"material", "heat"}, default: "material"
         ``material``: 1 while material is deposited (filament pushed on a
-        move); ``heat``: 1 while the laser/weld heat source is on during a move
+        move, or for DED a feed move with the heat source on); ``heat``: 1 while the laser/weld heat source is on during a move
         (DED, M61/M62).
 
     Returns
@@ -336,8 +336,10 @@ def gcode_dataframe_to_event_series(df: "pd.DataFrame", source: str = "material"
     end_t = df["elapsed_time"].to_numpy(float)[moved]
     start_t = end_t - np.nan_to_num(df["time"].to_numpy(float)[moved])
     start_xyz = np.vstack([np.zeros((1, 3)), xyz[:-1]])[moved]
-    if source == "material":
+    if source == "material":  # filament pushed, or (DED, no E words) the heat source on during a feed move
         value = (df["de"].to_numpy(float)[moved] > 0) & (df["distance"].to_numpy(float)[moved] > 0)
+        if "laser" in df:
+            value |= (df["laser"].to_numpy()[moved] == 1) & (motion[moved] >= 2)
     else:
         value = (df["laser"].to_numpy()[moved] == 1) & (motion[moved] >= 2)
     events = pd.DataFrame({"time": np.r_[start_t, end_t[-1]],

@@ -54,8 +54,9 @@ def _parser() -> argparse.ArgumentParser:
     render.add_argument("file", metavar="FILE")
     _common(render)
     render.add_argument("-o", "--output", metavar="OUT", required=True, help="PNG file to write")
-    render.add_argument("--color-by", default="feature", metavar="SCALAR",
-                        help="feature, speed, layer, time or any waypoint column such as feed or z (default: feature)")
+    render.add_argument("--color-by", metavar="SCALAR",
+                        help="feature, speed, layer, time or any waypoint column such as feed or z (default: feature "
+                             "when the program marks features, else layer for additive programs and feed for others)")
     render.add_argument("--view", choices=("iso", "top", "front", "side"), default="iso",
                         help="camera (default: iso)")
     render.add_argument("--travel", action="store_true", help="also draw travel moves")

@@ -34,6 +34,9 @@ CAMERAS = ("iso", "top", "front", "side")
 NAMED_SCALARS = {"feature": "feature", "speed": "speed (mm/s)", "layer": "layer", "time": "elapsed time (s)",
                  "feed": "feed (mm/min)", "tool": "tool", "laser": "heat source on"}
 _TRAVEL_COLOR = "#9a9a9a"
+#: matplotlib's "tab10", one colour per category (a colormap name would be sampled at its ends for two)
+_CATEGORY_COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+                    "#bcbd22", "#17becf"]
 _MAX_GLYPHS = 300
 
 
@@ -124,7 +127,16 @@ def _glyphs(pv, mesh: "pv.PolyData", size: float) -> "pv.PolyData":
     return picked.glyph(orient="tool_vector", scale=False, factor=size, geom=pv.Arrow())
 
 
-def plot_operation(op: "Operation", scalars: str = "feature", *, show_travel: bool = False,
+def default_scalars(op: "Operation") -> str:
+    """``feature`` when the program names its features, else ``layer`` (additive) or ``feed``."""
+    from .analysis import features
+
+    if op.flavor is not None and op.flavor.feature_comment and (features(op) != "").any():
+        return "feature"
+    return "layer" if _is_additive(op) else "feed"
+
+
+def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: bool = False,
                    tool_vectors: bool = False, off_screen: bool = True, screenshot: str | os.PathLike | None = None,
                    camera: str = "iso", window_size: tuple[int, int] = (1200, 900), line_width: float = 2.0,
                    cmap: str | None = None, background: str = "white",
@@ -134,9 +146,10 @@ def plot_operation(op: "Operation", scalars: str = "feature", *, show_travel: bo
     Parameters
     ----------
     op : Operation
-    scalars : str, default: "feature"
+    scalars : str, default: None
         Colour by ``feature``, ``speed``, ``layer``, ``time`` or any waypoint
-        column (see :func:`waypoint_scalars`).
+        column (see :func:`waypoint_scalars`); None picks ``feature`` when
+        the program marks features, else ``layer`` (additive) or ``feed``.
     show_travel : bool, default: False
         Also draw the moves that lay no material (rapids for a mill), grey.
     tool_vectors : bool, default: False
@@ -159,6 +172,7 @@ def plot_operation(op: "Operation", scalars: str = "feature", *, show_travel: bo
     from .additive.vtk import import_pyvista
 
     pv = import_pyvista()
+    scalars = scalars or default_scalars(op)
     mesh, travel, categories = operation_polydata(op, scalars)
     if mesh.n_cells == 0 and (travel.n_cells == 0 or not show_travel):
         raise ValueError(f"{op.file}: nothing to draw (no {'deposition' if _is_additive(op) else 'feed'} moves)")
@@ -170,10 +184,10 @@ def plot_operation(op: "Operation", scalars: str = "feature", *, show_travel: bo
                                fmt="%.0f" if mesh[scalars].dtype.kind in "iu" else "%.4g")
     kwargs: dict[str, Any] = dict(scalars=scalars, line_width=line_width, scalar_bar_args=bar,
                                   show_scalar_bar=scalar_bar,
-                                  cmap=cmap or ("tab10" if categories else "viridis"))
+                                  cmap=cmap or "viridis")
     if categories:
-        if len(categories) > 10 and cmap is None:
-            kwargs["cmap"] = "tab20"
+        if cmap is None:
+            kwargs["cmap"] = _CATEGORY_COLORS[:len(categories)] if len(categories) <= 10 else "tab20"
         kwargs.update(categories=True, clim=[-0.5, len(categories) - 0.5],
                       annotations={k: name for k, name in enumerate(categories)})
         bar.update(n_labels=0, n_colors=len(categories))

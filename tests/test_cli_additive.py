@@ -79,3 +79,11 @@ def test_render_errors_are_one_line(tmp_path, capsys):
     assert status == 2 and ".png" in err
     status, _, err = run(["render", "no/such.gcode", "-o", tmp_path / "y.png"], capsys)
     assert status == 2 and "no such file" in err
+
+
+def test_ded_material_events_follow_the_weld(capsys):
+    # DED programs have no E words: material is laid while the heat source is on during a feed move
+    _, heat, _ = run(["export", DOME, "--to", "events", "--source", "heat"], capsys)
+    _, material, _ = run(["export", DOME, "--to", "events"], capsys)
+    assert material == heat
+    assert np.loadtxt(material.splitlines(), delimiter=",")[:, 4].sum() > 100

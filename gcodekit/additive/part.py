@@ -91,9 +91,9 @@ class AdditivePart:
         self.bead = bead
         self.layer_normal = normal / np.linalg.norm(normal)
         w = operation.waypoints
-        self._xyz = np.column_stack([np.asarray(w[k], float) for k in "xyz"])
         along_z = np.allclose(self.layer_normal, (0.0, 0.0, 1.0))
-        height = self._xyz[:, 2] if along_z else self._xyz @ self.layer_normal
+        height = np.asarray(w["z"], float) if along_z else sum(
+            c * np.asarray(w[k], float) for c, k in zip(self.layer_normal, "xyz") if c)
         self.waypoint_layer = layers(operation, None if along_z else height)
         moves = np.flatnonzero((np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0))
         deposit = depositing(w)[moves]
@@ -104,6 +104,7 @@ class AdditivePart:
         last_move = np.r_[first_move[1:] - 1, moves.size - 1] if moves.size else first_move
         self._moves = moves
         self._segment_moves = (first_move, last_move)
+        self._layer_times: "pd.DataFrame | None" = None
         self.summary = self._summarize(moves, first_move, last_move, deposit, height)
 
     # -- construction --------------------------------------------------------
@@ -187,6 +188,8 @@ class AdditivePart:
         """Per layer: ``time`` (s, travel included), ``deposition_time``,
         ``deposition_length`` (mm), ``volume`` (mm^3) and ``height`` (mm,
         length-weighted mean height of its depositions)."""
+        if self._layer_times is not None:
+            return self._layer_times.copy()
         import pandas as pd
 
         w = self.operation.waypoints
@@ -203,9 +206,10 @@ class AdditivePart:
         length = by_layer(dep["length"])
         with np.errstate(invalid="ignore", divide="ignore"):
             height = by_layer(dep["height"] * dep["length"]) / length
-        return pd.DataFrame({"time": time, "deposition_time": by_layer(dep["time"]), "deposition_length": length,
-                             "volume": by_layer(dep["volume"]), "height": height},
-                            index=pd.RangeIndex(size, name="layer"))
+        self._layer_times = pd.DataFrame({"time": time, "deposition_time": by_layer(dep["time"]),
+                                          "deposition_length": length, "volume": by_layer(dep["volume"]),
+                                          "height": height}, index=pd.RangeIndex(size, name="layer"))
+        return self._layer_times.copy()
 
     def bead_geometry(self) -> dict[str, np.ndarray]:
         """``bead_width``, ``bead_height``, ``bead_area`` of each deposition segment, mm and mm^2.
@@ -248,7 +252,11 @@ class AdditivePart:
         is_start[offsets[:-1]] = True
         waypoint[~is_start] = move_rows
         waypoint[is_start] = self.summary["start"].to_numpy()[dep] - 1
-        points = self._xyz[np.maximum(waypoint, 0)]
+        w = self.operation.waypoints
+        points = np.empty((waypoint.size, 3))
+        rows = np.maximum(waypoint, 0)
+        for axis, key in enumerate("xyz"):
+            points[:, axis] = np.asarray(w[key], float)[rows]
         points[waypoint < 0] = 0.0  # a program's very first move starts at the machine's origin
         return points, offsets, np.maximum(waypoint, 0)
 
