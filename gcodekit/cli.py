@@ -248,7 +248,10 @@ def _export(args: argparse.Namespace) -> int:
         if op.machine.process != "additive":
             raise ValueError(f"{args.file}: VTK export is for additive programs; machine {op.machine.name!r} "
                              f"is {op.machine.process}")
-        VTKExporter.additive_part_to_vtk(AdditivePart(op), output)
+        part = AdditivePart(op)
+        if part.depositions.empty:
+            raise ValueError(f"{args.file}: no deposition moves to export")
+        VTKExporter.additive_part_to_vtk(part, output)
     _report_errors(op)
     return 0
 

@@ -54,7 +54,7 @@ def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
 
     w = op.waypoints
     moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
-    moving[0] = False  # a move is drawn from the waypoint before it
+    moving[:1] = False  # a move is drawn from the waypoint before it
     if _is_additive(op):
         work = depositing(w) & (layers(op) >= 0)
     else:

@@ -87,3 +87,12 @@ def test_ded_material_events_follow_the_weld(capsys):
     _, material, _ = run(["export", DOME, "--to", "events"], capsys)
     assert material == heat
     assert np.loadtxt(material.splitlines(), delimiter=",")[:, 4].sum() > 100
+
+
+@pytest.mark.parametrize("text", ["", "G28\nG1 X10 Y10 F3000\n"])
+def test_programs_that_lay_nothing(tmp_path, capsys, text):
+    program = tmp_path / "nothing.gcode"
+    program.write_text(text)
+    for args in (["render", program, "-o", tmp_path / "n.png"], ["export", program, "--to", "vtk", "-o", tmp_path / "n.vtp"]):
+        status, _, err = run(args, capsys)
+        assert status == 2 and "nothing.gcode" in err and "Traceback" not in err
