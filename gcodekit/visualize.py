@@ -87,10 +87,30 @@ def waypoint_scalars(op: "Operation", scalars: str) -> tuple[np.ndarray, list[st
     return np.asarray(w[scalars]), None
 
 
-def _lines(pv, xyz: np.ndarray, rows: np.ndarray) -> "pv.PolyData":
-    """One two-point line cell per move, sharing the waypoint points (move ``i`` runs ``i-1 -> i``)."""
-    cells = np.column_stack([np.full(rows.size, 2), rows - 1, rows]).ravel()
-    mesh = pv.PolyData(xyz, lines=cells)
+def _lines(pv, w: dict, xyz: np.ndarray, rows: np.ndarray) -> "pv.PolyData":
+    """One line cell per move (move ``i`` runs from waypoint ``i-1`` to ``i``).
+
+    The cells share the waypoint points; an arc's cell passes through its
+    interior points (every 5 degrees), added after them.
+    """
+    from .emulate.arcs import waypoint_arc_points
+
+    interior, counts = waypoint_arc_points(w, rows)
+    size = counts + 2
+    # VTK's cell array: per cell its size, its start, its interior points, its end
+    cells = np.empty(int((size + 1).sum()), np.int64)
+    head = np.cumsum(size + 1) - (size + 1)
+    cells[head] = size
+    cells[head + 1] = rows - 1
+    cells[head + size] = rows
+    inside = np.ones(cells.size, bool)
+    inside[np.r_[head, head + 1, head + size]] = False
+    cells[inside] = xyz.shape[0] + np.arange(interior.shape[0])
+    mesh = pv.PolyData(np.vstack([xyz, interior]) if interior.size else xyz, lines=cells)
+    # the points no cell uses (the rest of the program) must not move the camera
+    drawn = np.vstack([xyz[np.r_[rows - 1, rows]], interior])
+    if drawn.size:
+        mesh.field_data["drawn_bounds"] = np.r_[drawn.min(axis=0), drawn.max(axis=0)]
     return mesh
 
 
@@ -104,7 +124,7 @@ def operation_polydata(op: "Operation", scalars: str = "feature") -> tuple["pv.P
     work, travel = move_masks(op)
     values, categories = waypoint_scalars(op, scalars)
     work_rows = np.flatnonzero(work)
-    mesh = _lines(pv, xyz, work_rows)
+    mesh = _lines(pv, w, xyz, work_rows)
     values = values[work_rows]
     if categories is not None:  # keep the categories the drawn moves have
         used, values = np.unique(values, return_inverse=True)
@@ -115,7 +135,7 @@ def operation_polydata(op: "Operation", scalars: str = "feature") -> tuple["pv.P
         from .analysis import tool_vectors
 
         mesh.cell_data["tool_vector"] = tool_vectors(a[work_rows], b[work_rows])
-    return mesh, _lines(pv, xyz, np.flatnonzero(travel)), categories
+    return mesh, _lines(pv, w, xyz, np.flatnonzero(travel)), categories
 
 
 def _glyphs(pv, mesh: "pv.PolyData", size: float) -> "pv.PolyData":
@@ -196,7 +216,8 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
     if show_travel and travel.n_cells:
         plotter.add_mesh(travel, color=_TRAVEL_COLOR, line_width=max(line_width / 2, 1.0), opacity=0.6)
     if tool_vectors and "tool_vector" in mesh.cell_data:
-        size = 0.04 * float(np.linalg.norm(np.ptp(mesh.points[np.unique(mesh.lines.reshape(-1, 3)[:, 1:])], axis=0)))
+        lo_hi = mesh.field_data["drawn_bounds"]
+        size = 0.04 * float(np.linalg.norm(lo_hi[3:] - lo_hi[:3]))
         plotter.add_mesh(_glyphs(pv, mesh, size), color="#d62728")
     {"iso": plotter.view_isometric, "top": plotter.view_xy, "front": plotter.view_xz,
      "side": plotter.view_yz}[camera]()
@@ -215,8 +236,7 @@ def _is_emulated(op) -> bool:
 
 def _frame(plotter, mesh) -> None:
     """Fit the camera to the drawn moves only (not the machine's home position)."""
-    used = np.unique(mesh.lines.reshape(-1, 3)[:, 1:])
-    lo, hi = mesh.points[used].min(axis=0), mesh.points[used].max(axis=0)
+    lo, hi = mesh.field_data["drawn_bounds"][:3], mesh.field_data["drawn_bounds"][3:]
     plotter.reset_camera(bounds=[lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]])
     plotter.camera.zoom(1.05)
 

@@ -111,9 +111,15 @@ def test_layer_times_add_up(op):
 
 def test_deposition_paths(op):
     paths = list(AdditivePart(op).generate_deposition_paths())
-    # the arc is taken by its chord
-    assert [p.tolist() for p in paths] == [[[10, 10, 0.2], [30, 10, 0.2], [30, 30, 0.2]],
-                                           [[10, 30, 0.4], [10, 10, 0.4], [30, 10, 0.4]]]
+    assert paths[0].tolist() == [[10, 10, 0.2], [30, 10, 0.2], [30, 30, 0.2]]
+    assert paths[1][:2].tolist() == [[10, 30, 0.4], [10, 10, 0.4]] and paths[1][-1].tolist() == [30, 10, 0.4]
+    # the G3 half circle about (20, 10), counter-clockwise from the left: below Y10, a point every 5 degrees
+    arc = paths[1][2:-1]
+    assert len(arc) == 180 // 5 - 1
+    assert np.hypot(arc[:, 0] - 20, arc[:, 1] - 10) == pytest.approx(np.full(len(arc), 10.0))
+    assert np.all(arc[:, 1] < 10) and np.all(np.diff(arc[:, 0]) > 0)
+    length = np.linalg.norm(np.diff(paths[1], axis=0), axis=1).sum()
+    assert length == pytest.approx(20 + 10 * math.pi, rel=1e-3)
 
 
 def test_layers_along_a_tilted_normal():

@@ -81,3 +81,14 @@ def test_custom_scalars_must_fit(cube):
         VTKExporter.additive_part_to_polydata(cube, custom_scalars={"t": np.zeros(3)})
     with pytest.raises(ValueError, match=".vtp"):
         VTKExporter.additive_part_to_vtk(cube, "cube.stl")
+
+
+def test_arcs_become_polylines_as_long_as_the_arcs(shared_dir, tmp_path):
+    # ArcWelder turned the cylinder's perimeters into G2/G3; each cell must follow the arcs, not their chords
+    op = gcodekit.gcode_to_operation(shared_dir / "corpus" / "fff" / "cylinder_marlin2_arcwelder.gcode", plan=False)
+    assert np.count_nonzero(op.waypoints["motion"] >= 3) > 10_000
+    part = AdditivePart(op)
+    mesh = pv.read(VTKExporter.additive_part_to_vtk(part, tmp_path / "cylinder.vtp"))
+    lengths = _cell_lengths(mesh)
+    assert lengths.sum() == pytest.approx(part.deposition_length, rel=1e-3)
+    assert lengths == pytest.approx(part.depositions["length"].to_numpy(), rel=2e-3, abs=1e-6)

@@ -9,7 +9,7 @@ the part's length, volume or mass.  Each segment keeps
 the first and last waypoint of its moves, so any question about it goes back
 to ``operation.waypoints`` (or ``operation.process_data``) by index.
 
-Arcs are taken by their chords (waypoints hold arc end points only).
+Paths follow arcs with a point every 5 degrees (waypoints hold only their end points).
 
 Examples
 --------
@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..emulate.arcs import waypoint_arc_points
 from .bead import Bead
 
 if TYPE_CHECKING:
@@ -238,8 +239,9 @@ class AdditivePart:
 
         Returns ``(points, offsets, waypoint)``: path ``k`` is
         ``points[offsets[k]:offsets[k + 1]]`` (its start, then each move's
-        end), and ``waypoint`` gives each point's waypoint index (the start
-        point's is the waypoint before the first move).
+        end, arcs with points every 5 degrees before their end), and
+        ``waypoint`` gives each point's waypoint index (the start point's is
+        the waypoint before the first move, an arc's points are its own).
         """
         first_move, last_move = self._segment_moves
         dep = np.flatnonzero(self.summary["kind"].to_numpy() == "deposition")
@@ -253,12 +255,20 @@ class AdditivePart:
         waypoint[~is_start] = move_rows
         waypoint[is_start] = self.summary["start"].to_numpy()[dep] - 1
         w = self.operation.waypoints
-        points = np.empty((waypoint.size, 3))
         rows = np.maximum(waypoint, 0)
+        # an arc's end point comes after its interior points: one group of points per original point
+        counts = np.zeros(rows.size, np.int64)
+        interior, counts[~is_start] = waypoint_arc_points(w, move_rows)
+        group = counts + 1
+        ends = np.cumsum(group)
+        expand = np.repeat(np.arange(rows.size), group)
+        points = np.empty((expand.size, 3))
         for axis, key in enumerate("xyz"):
-            points[:, axis] = np.asarray(w[key], float)[rows]
-        points[waypoint < 0] = 0.0  # a program's very first move starts at the machine's origin
-        return points, offsets, np.maximum(waypoint, 0)
+            points[:, axis] = np.asarray(w[key], float)[rows[expand]]
+        points[np.repeat(waypoint < 0, group)] = 0.0  # a program's very first move starts at the machine's origin
+        inside = np.arange(expand.size) < np.repeat(ends - 1, group)
+        points[inside] = interior
+        return points, np.r_[(ends - group)[offsets[:-1]], expand.size], rows[expand]
 
     def generate_deposition_paths(self) -> Iterator[np.ndarray]:
         """Each deposition segment as an ``(n, 3)`` array of x, y, z points, mm."""
