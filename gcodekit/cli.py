@@ -132,6 +132,8 @@ def summary(op) -> dict[str, Any]:
         "planner": op.machine.planner or None,
         "layers": stats["layers"],
         "filament_mm": stats["filament_mm"],
+        "filament_convention": stats["filament_convention"],
+        "filament_pushed_mm": stats["filament_pushed_mm"],
         "tools": stats["tools"],
         "diagnostics": [d.as_dict() for d in op.diagnostics],
         "diagnostics_dropped": op.diagnostics.dropped,

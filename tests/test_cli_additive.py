@@ -96,3 +96,16 @@ def test_programs_that_lay_nothing(tmp_path, capsys, text):
     for args in (["render", program, "-o", tmp_path / "n.png"], ["export", program, "--to", "vtk", "-o", tmp_path / "n.vtp"]):
         status, _, err = run(args, capsys)
         assert status == 2 and "nothing.gcode" in err and "Traceback" not in err
+
+
+def test_info_json_gives_both_filament_figures(capsys):
+    import json
+
+    status, out, _ = run(["info", PRINT, "--json"], capsys)
+    record = json.loads(out)
+    # PrusaSlicer wrote "; filament used [mm] = 1276.70"; the program runs under M221 S95
+    assert record["filament_convention"] == "consumed"
+    assert record["filament_mm"] == pytest.approx(1276.70, abs=0.01)
+    # pushed: the intro lines (E9 + E12.5) at full flow, the rest of the program's net E (1296.403 mm,
+    # summed from its E words separately) at 95 %
+    assert record["filament_pushed_mm"] == pytest.approx(21.5 + 0.95 * (1296.403 - 21.5), abs=0.01)
