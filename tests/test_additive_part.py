@@ -67,6 +67,8 @@ def test_segments_layers_and_lengths(op):
     assert part.deposition_length == pytest.approx(60.0 + 10 * math.pi)
     # start/end index the waypoints: the first and last move of each segment
     w = op.waypoints
+    first = op.process_data[int(dep["start_command"].iloc[0])]
+    assert first.location[:3] == (30.0, 10.0, 0.2) and first.deposited_volume == pytest.approx(2 * FILAMENT_AREA)
     for row in dep.itertuples():
         assert w["distance"][row.start] > 0 and w["distance"][row.end] > 0
         assert np.asarray(w["distance"][row.start:row.end + 1]).sum() == pytest.approx(row.length)

@@ -71,7 +71,9 @@ class AdditivePart:
     summary : DataFrame
         One row per segment: ``kind`` (``deposition``, ``travel``, or
         ``purge`` for material laid before the first layer), ``start``
-        and ``end`` (first and last waypoint of its moves), ``moves``,
+        and ``end`` (first and last waypoint of its moves, rows of
+        ``operation.waypoints``), ``start_command`` and ``end_command``
+        (the same as indices of ``operation.process_data``), ``moves``,
         ``layer``, ``length`` (mm), ``start_time``/``end_time``/``time`` (s),
         ``filament`` (mm pushed, M221 applied), ``volume`` (mm^3) and
         ``height`` (mm along the normal at its start).
@@ -116,7 +118,6 @@ class AdditivePart:
         w = self.operation.waypoints
         start, end = moves[first_move], moves[last_move]
         elapsed = self.operation.elapsed_time()
-        duration = np.nan_to_num(np.asarray(w["time"], float))
 
         def per_segment(column):
             values = np.asarray(column, float)[moves]
@@ -124,13 +125,17 @@ class AdditivePart:
 
         length = per_segment(w["distance"])
         filament = per_segment(w["de"])
-        start_time = elapsed[start] - duration[start]
+        start_time = elapsed[start] - np.nan_to_num(np.asarray(w["time"], float)[start])
+        command = w.get("command")  # waypoint -> command row, when some command made extra waypoints
         # material laid before the first layer is start code's (purge lines), not the part's
         kind = np.where(deposit[first_move], np.where(self.waypoint_layer[start] >= 0, "deposition", "purge"),
                         "travel") if first_move.size else np.zeros(0, str)
         frame = pd.DataFrame({
             "kind": pd.Categorical(kind, categories=["deposition", "travel", "purge"]),
-            "start": start, "end": end, "moves": last_move - first_move + 1,
+            "start": start, "end": end,
+            "start_command": start if command is None else command[start],
+            "end_command": end if command is None else command[end],
+            "moves": last_move - first_move + 1,
             "layer": self.waypoint_layer[start], "length": length,
             "start_time": start_time, "end_time": elapsed[end], "time": elapsed[end] - start_time,
             "filament": filament, "height": height[np.maximum(start - 1, 0)],
