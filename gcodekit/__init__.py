@@ -17,6 +17,8 @@ from .emulate.operation import (
     SubtractiveOperation,
     SubtractiveProcessData,
 )
+from .additive import AdditivePart, Bead, VTKExporter
+from . import visualize
 from .analysis import export_event_series_from_gcode, gcode_dataframe_to_event_series
 from .emulate.exporters import GcodeExporter
 from .emulate.presets import MachineConfig, list_machines, load_machine
@@ -36,7 +38,7 @@ from .syntax import detect_flavor, list_flavors, load_flavor
 __version__ = "0.1.0"
 
 __all__ = [
-    "AdditiveOperation", "AdditiveProcessData", "ConfigError", "GcodeExporter", "Diagnostic", "GcodeError",
+    "AdditiveOperation", "AdditivePart", "AdditiveProcessData", "Bead", "VTKExporter", "ConfigError", "GcodeExporter", "Diagnostic", "GcodeError",
     "GcodeExpressionError", "GcodeLimitError", "GcodeMachineError", "GcodeParser", "GcodeSyntaxError",
     "MachineConfig", "Operation", "ProcessData", "SubtractiveOperation", "SubtractiveProcessData",
     "detect_flavor", "emulate_operation", "export_event_series_from_gcode", "gcode_dataframe_to_event_series", "gcode_file_to_dataframe", "gcode_to_operation", "list_flavors",

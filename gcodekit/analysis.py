@@ -37,7 +37,7 @@ def depositing(w: dict, screw: bool = False) -> np.ndarray:
 
 def screw_extruder(op: "Operation") -> bool:
     """Whether the operation's machine deposits with a screw extruder."""
-    return op.machine is not None and op.machine.extruder == "screw"
+    return op.machine is not None and op.machine.extruder_type == "screw"
 
 
 def operation_statistics(op: "Operation") -> dict[str, Any]:
@@ -66,10 +66,17 @@ def operation_statistics(op: "Operation") -> dict[str, Any]:
         "bounds": op.get_bounds(),
     }
     if op.machine is not None and op.machine.process == "additive":
-        stats["filament_mm"] = None if screw_extruder(op) else float(de.sum())  # pellets: no filament
+        if screw_extruder(op):  # pellets: no filament
+            stats["filament_mm"] = stats["filament_convention"] = stats["filament_pushed_mm"] = None
+        else:
+            from .additive.filament import filament_used, slicer_convention
+
+            stats["filament_mm"] = filament_used(op)
+            stats["filament_convention"] = slicer_convention(op)
+            stats["filament_pushed_mm"] = float(de.sum())
         stats["layers"] = count_layers(op)
     else:
-        stats["filament_mm"] = None
+        stats["filament_mm"] = stats["filament_convention"] = stats["filament_pushed_mm"] = None
         stats["layers"] = None
     return stats
 
@@ -129,25 +136,28 @@ def features(op: "Operation") -> np.ndarray:
     return names[marks[waypoint_rows(op)] + 1]
 
 
-def layers(op: "Operation") -> np.ndarray:
+def layers(op: "Operation", heights: np.ndarray | None = None) -> np.ndarray:
     """Layer number (0-based) of each waypoint, -1 before the first layer.
 
-    From the flavor's layer-change comments when the program has them; else a
-    new layer starts at each new Z height reached by an extruding move.
+    From the flavor's layer-change comments when the program has them and no
+    ``heights`` are given; else a new layer starts at each new height reached
+    by a depositing move.  ``heights`` (mm, one per waypoint) default to Z;
+    pass the positions projected on another layer normal for tilted layers.
     """
-    marks = np.full(len(op.table), -1, np.int64)
-    for pattern in (op.flavor.layer_comments if op.flavor else ()):
-        found, labels = _row_labels(op, f"({pattern})")
-        if labels:
-            marks = found
-            break
-    if (marks >= 0).any():
-        return marks[waypoint_rows(op)]
-    w = op.waypoints
-    extruding = depositing(w, screw_extruder(op))
-    z = np.round(np.asarray(w["z"]), 4)
-    new_layer = extruding & (z != np.r_[np.nan, z[:-1]])
-    starts = np.flatnonzero(new_layer)
+    if heights is None:
+        marks = np.full(len(op.table), -1, np.int64)
+        for pattern in (op.flavor.layer_comments if op.flavor else ()):
+            found, labels = _row_labels(op, f"({pattern})")
+            if labels:
+                marks = found
+                break
+        if (marks >= 0).any():
+            return marks[waypoint_rows(op)]
+        heights = op.waypoints["z"]
+    extruding = np.flatnonzero(depositing(op.waypoints, screw_extruder(op)))
+    z = np.round(np.asarray(heights, float), 4)
+    at = z[extruding]
+    starts = extruding[np.r_[True, at[1:] != at[:-1]]] if extruding.size else extruding
     # a layer begins at its first extruding move; heights already printed are not new
     seen = np.unique(z[starts], return_index=True)[1]
     first = np.zeros(z.size, bool)
@@ -174,7 +184,7 @@ def time_by(op: "Operation", key: str = "layer") -> "pd.DataFrame":
     check_choice("key", key, ("layer", "feature", "tool"))
     w = op.waypoints
     labels = {"layer": layers, "feature": features, "tool": lambda o: np.asarray(o.waypoints["tool"])}[key](op)
-    extruding = (w["motion"] > 0) & (w["de"] > 0)
+    extruding = depositing(w, screw_extruder(op))
     frame = pd.DataFrame({
         key: labels,
         "time_s": np.nan_to_num(np.asarray(w["time"], float)),
@@ -307,7 +317,7 @@ def gcode_dataframe_to_event_series(df: "pd.DataFrame", source: str = "material"
         ``laser`` for ``source="heat"``).
     source : {"material", "heat"}, default: "material"
         ``material``: 1 while material is deposited (filament pushed on a
-        move); ``heat``: 1 while the laser/weld heat source is on during a move
+        move, or for DED a feed move with the heat source on); ``heat``: 1 while the laser/weld heat source is on during a move
         (DED, M61/M62).
 
     Returns
@@ -337,8 +347,10 @@ def gcode_dataframe_to_event_series(df: "pd.DataFrame", source: str = "material"
     end_t = df["elapsed_time"].to_numpy(float)[moved]
     start_t = end_t - np.nan_to_num(df["time"].to_numpy(float)[moved])
     start_xyz = np.vstack([np.zeros((1, 3)), xyz[:-1]])[moved]
-    if source == "material":
+    if source == "material":  # filament pushed, or (DED, no E words) the heat source on during a feed move
         value = (df["de"].to_numpy(float)[moved] > 0) & (df["distance"].to_numpy(float)[moved] > 0)
+        if "laser" in df:
+            value |= (df["laser"].to_numpy()[moved] == 1) & (motion[moved] >= 2)
     else:
         value = (df["laser"].to_numpy()[moved] == 1) & (motion[moved] >= 2)
     events = pd.DataFrame({"time": np.r_[start_t, end_t[-1]],

@@ -1,4 +1,4 @@
-"""Command line: ``gcodekit info``, ``gcodekit export`` and ``gcodekit translate``.
+"""Command line: ``gcodekit info``, ``export``, ``render`` and ``translate``.
 
 Examples
 --------
@@ -7,6 +7,8 @@ Examples
     gcodekit info part.gcode --json
     gcodekit info part.ngc --machine linuxcnc
     gcodekit export part.ngc --to csv -o part.csv
+    gcodekit export print.gcode --to vtk -o print.vtp
+    gcodekit render print.gcode -o print.png --color-by speed --view top
 """
 
 from __future__ import annotations
@@ -21,7 +23,9 @@ from typing import Any, Sequence
 
 from .errors import ConfigError, GcodeError
 
-EXPORT_FORMATS = ("csv",)
+EXPORT_FORMATS = ("csv", "parquet", "vtk", "events")
+#: Output file name ending of each format when ``-o`` is not given (None: standard output).
+_DEFAULT_SUFFIX = {"csv": None, "events": None, "parquet": ".parquet", "vtk": ".vtp"}
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -33,12 +37,32 @@ def _parser() -> argparse.ArgumentParser:
     _common(info)
     info.add_argument("--json", action="store_true", help="one JSON object per file (a list when several)")
 
-    export = sub.add_parser("export", help="write the motions of a program to a table")
+    export = sub.add_parser("export", help="write the motions of a program to a table, a VTK mesh or an event series")
     export.add_argument("file", metavar="FILE")
     _common(export)
-    export.add_argument("--to", choices=EXPORT_FORMATS, default="csv", help="output format (default: csv)")
-    export.add_argument("-o", "--output", metavar="OUT", help="output file (default: standard output)")
+    export.add_argument("--to", choices=EXPORT_FORMATS, default="csv",
+                        help="csv or parquet: one row per motion; vtk: the deposition paths of an additive program "
+                             "(.vtp or .vtk); events: the Abaqus AM event series (default: csv)")
+    export.add_argument("--source", choices=("material", "heat"), default="material",
+                        help="events: material deposition or the laser/weld heat source (default: material)")
+    export.add_argument("-o", "--output", metavar="OUT",
+                        help="output file (default: standard output for csv and events, FILE's name with "
+                             ".parquet or .vtp in the current directory otherwise)")
     export.add_argument("-f", "--force", action="store_true", help="overwrite OUT if it exists")
+
+    render = sub.add_parser("render", help="draw the toolpath to a PNG, off-screen")
+    render.add_argument("file", metavar="FILE")
+    _common(render)
+    render.add_argument("-o", "--output", metavar="OUT", required=True, help="PNG file to write")
+    render.add_argument("--color-by", metavar="SCALAR",
+                        help="feature, speed, layer, time or any waypoint column such as feed or z (default: feature "
+                             "when the program marks features, else layer for additive programs and feed for others)")
+    render.add_argument("--view", choices=("iso", "top", "front", "side"), default="iso",
+                        help="camera (default: iso)")
+    render.add_argument("--travel", action="store_true", help="also draw travel moves")
+    render.add_argument("--tool-vectors", action="store_true", help="arrows along the head direction (5-axis)")
+    render.add_argument("--size", default="1200x900", metavar="WxH", help="image size in pixels (default: 1200x900)")
+    render.add_argument("-f", "--force", action="store_true", help="overwrite OUT if it exists")
 
     translate = sub.add_parser("translate", help="simplify a mill program stage by stage (GER's transpiler)")
     translate.add_argument("file", metavar="FILE")
@@ -69,8 +93,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _info(args)
         if args.command == "translate":
             return _translate(args)
+        if args.command == "render":
+            return _render(args)
         return _export(args)
-    except (GcodeError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
+    except (GcodeError, FileNotFoundError, IsADirectoryError, PermissionError, ValueError, ImportError) as exc:
         print(f"gcodekit: error: {exc}", file=sys.stderr)
         return 1 if isinstance(exc, GcodeError) and not isinstance(exc, ConfigError) else 2
     except BrokenPipeError:
@@ -106,6 +132,8 @@ def summary(op) -> dict[str, Any]:
         "planner": op.machine.planner or None,
         "layers": stats["layers"],
         "filament_mm": stats["filament_mm"],
+        "filament_convention": stats["filament_convention"],
+        "filament_pushed_mm": stats["filament_pushed_mm"],
         "tools": stats["tools"],
         "diagnostics": [d.as_dict() for d in op.diagnostics],
         "diagnostics_dropped": op.diagnostics.dropped,
@@ -181,25 +209,80 @@ def _duration(seconds: float) -> str:
     return f"{h}:{mnt:02d}:{s:02d} ({seconds:.1f} s)"
 
 
+def _exists(path: str | None, args: argparse.Namespace) -> bool:
+    """Refuse to overwrite ``path`` without --force (True: refused, message printed)."""
+    if path and os.path.exists(path) and not args.force:
+        print(f"gcodekit: error: {path} exists; use --force to overwrite it", file=sys.stderr)
+        return True
+    return False
+
+
+def _report_errors(op) -> None:
+    for d in [d for d in op.diagnostics if d.severity == "error"][:10]:
+        print(str(d), file=sys.stderr)
+
+
 def _export(args: argparse.Namespace) -> int:
-    if args.output and os.path.exists(args.output) and not args.force:
-        print(f"gcodekit: error: {args.output} exists; use --force to overwrite it", file=sys.stderr)
+    output = args.output
+    if output is None and _DEFAULT_SUFFIX[args.to]:
+        output = Path(args.file).name.removesuffix(".gz")
+        output = str(Path(output).with_suffix(_DEFAULT_SUFFIX[args.to]))
+    if args.to == "vtk" and output and Path(output).suffix.lower() not in (".vtk", ".vtp"):
+        raise ValueError(f"{output}: a VTK export is written to a .vtp or .vtk file")
+    if _exists(output, args):
         return 2
     op = _load(args.file, args)
-    frame = op.motions()
-    target = args.output if args.output else sys.stdout
-    frame.to_csv(target, index=False, float_format="%.6f", lineterminator="\n")
-    errors = [d for d in op.diagnostics if d.severity == "error"]
-    for d in errors[:10]:
-        print(str(d), file=sys.stderr)
+    target = output if output else sys.stdout
+    if args.to == "csv":
+        op.motions().to_csv(target, index=False, float_format="%.6f", lineterminator="\n")
+    elif args.to == "parquet":
+        try:
+            op.motions().to_parquet(target, index=False)
+        except ImportError as exc:
+            raise ImportError("parquet export needs pyarrow: pip install 'gcodekit[parquet]'") from exc
+    elif args.to == "events":
+        from .analysis import gcode_dataframe_to_event_series
+
+        events = gcode_dataframe_to_event_series(op.to_dataframe(), args.source)
+        events.to_csv(target, header=False, index=False, float_format="%.6f", lineterminator="\n")
+    else:
+        from .additive import AdditivePart, VTKExporter
+
+        if op.machine.process != "additive":
+            raise ValueError(f"{args.file}: VTK export is for additive programs; machine {op.machine.name!r} "
+                             f"is {op.machine.process}")
+        part = AdditivePart(op)
+        if part.depositions.empty:
+            raise ValueError(f"{args.file}: no deposition moves to export")
+        VTKExporter.additive_part_to_vtk(part, output)
+    _report_errors(op)
+    return 0
+
+
+def _render(args: argparse.Namespace) -> int:
+    from .visualize import plot_operation
+
+    try:
+        size = tuple(int(v) for v in args.size.lower().split("x"))
+    except ValueError:
+        size = ()
+    if len(size) != 2 or min(size) < 16:
+        raise ValueError(f"--size {args.size!r}: give width x height in pixels, e.g. 1200x900")
+    if Path(args.output).suffix.lower() != ".png":
+        raise ValueError(f"{args.output}: render writes a .png file")
+    if _exists(args.output, args):
+        return 2
+    op = _load(args.file, args)
+    plot_operation(op, args.color_by, show_travel=args.travel, tool_vectors=args.tool_vectors, camera=args.view,
+                   screenshot=args.output, window_size=size)
+    _report_errors(op)
     return 0
 
 
 def _translate(args: argparse.Namespace) -> int:
     from .transpile import Transpiler
 
-    if args.output and os.path.exists(args.output) and not args.force:
-        print(f"gcodekit: error: {args.output} exists; use --force to overwrite it", file=sys.stderr)
+    if _exists(args.output, args):
         return 2
     op = _load(args.file, args)
     text = Transpiler(op).stage(args.stage)
@@ -212,8 +295,7 @@ def _translate(args: argparse.Namespace) -> int:
         Path(args.output).write_text(text)
     else:
         sys.stdout.write(text)
-    for d in [d for d in op.diagnostics if d.severity == "error"][:10]:
-        print(str(d), file=sys.stderr)
+    _report_errors(op)
     return 0
 
 

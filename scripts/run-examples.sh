@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job: emulate every bundled example and write its summary (text and
-# JSON) and motion table into out/examples/.
+# JSON), motion table and picture into out/examples/, and for additive programs
+# a VTK mesh and an Abaqus event series.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 source "$ROOT/scripts/setup.sh"
@@ -11,5 +12,11 @@ for program in "$ROOT"/examples/*.*; do
   "$VENV/bin/gcodekit" info "$program" | tee "$OUT/$name.txt"
   "$VENV/bin/gcodekit" info "$program" --json > "$OUT/$name.json"
   "$VENV/bin/gcodekit" export "$program" --to csv -o "$OUT/$name.motions.csv" --force
+  "$VENV/bin/gcodekit" render "$program" -o "$OUT/$name.png" --force
+  # additive programs (those with layers) also as a VTK mesh and an Abaqus event series
+  if "$VENV/bin/python" -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["layers"] is None)' "$OUT/$name.json"; then
+    "$VENV/bin/gcodekit" export "$program" --to vtk -o "$OUT/$name.vtp" --force
+    "$VENV/bin/gcodekit" export "$program" --to events -o "$OUT/$name.events.csv" --force
+  fi
 done
-echo "summaries and motion tables written to $OUT"
+echo "summaries, motion tables, pictures, VTK meshes and event series written to $OUT"

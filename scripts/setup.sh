@@ -25,6 +25,17 @@ if [ ! -x "$VENV/bin/python" ]; then
   fi
 fi
 
+# Off-screen pictures (VTK through EGL) need Mesa's EGL and software renderer.
+if ! { compgen -G '/usr/lib/*/libEGL.so.1' >/dev/null && [ -e /usr/share/glvnd/egl_vendor.d/50_mesa.json ]; }; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    echo "gcodekit setup: installing Mesa EGL (libegl1 libegl-mesa0 libgl1-mesa-dri) for off-screen pictures" >&2
+    { apt-get update -qq && apt-get install -y -qq libegl1 libegl-mesa0 libgl1-mesa-dri >/dev/null; } \
+      || echo "gcodekit setup: warning: apt-get could not install Mesa EGL; 3D pictures will fail" >&2
+  else
+    echo "gcodekit setup: warning: 3D pictures need Mesa EGL (apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri)" >&2
+  fi
+fi
+
 want=$(cat "$ROOT/pyproject.toml" | sha256sum | cut -d' ' -f1)
 if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$want" ]; then
   echo "gcodekit setup: installing gcodekit and its test tools into .venv" >&2

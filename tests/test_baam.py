@@ -59,3 +59,12 @@ def test_planner_stops_before_and_after_the_layer_change():
     _, free_result = free.plan
     assert free_result.end_v[change - 1] > 0.0  # a plain corner otherwise
     assert free.get_statistics()["time_s"] < op.get_statistics()["time_s"]  # the stops cost time
+
+
+def test_additive_part_counts_the_screws_volume_per_layer():
+    op = gcodekit.gcode_to_operation(WALL, screw_displacement=2.0)
+    part = gcodekit.AdditivePart(op)
+    assert part.n_layers == 2
+    assert part.deposition_length == pytest.approx(2 * 60 * INCH)
+    # each perimeter: 4 sides of 2 s (20 in) and 1 s (10 in) -> 6 s; 110 then 120 rpm, 2 cm^3 per rev
+    assert part.volume == pytest.approx((110 + 120) * 6 / 60 * 2.0 * 1000)

@@ -70,3 +70,73 @@ def sweep(start: np.ndarray, end: np.ndarray, center: np.ndarray, clockwise: np.
 def arc_length(radius: np.ndarray, angle: np.ndarray, helix: np.ndarray) -> np.ndarray:
     """Length of a helical arc: hypotenuse of the unrolled arc and its rise."""
     return np.hypot(radius * angle, helix)
+
+
+def interior_points(start: np.ndarray, end: np.ndarray, center: np.ndarray, plane: np.ndarray,
+                    clockwise: np.ndarray, length: np.ndarray, max_angle: float = np.radians(5.0)):
+    """Points inside arcs, for drawing them as poly-lines.
+
+    Parameters
+    ----------
+    start, end, center : ndarray, shape (n, 3)
+        X, Y, Z of each arc's start, end and centre (the helix-axis
+        coordinate of the centre is not used).
+    plane : ndarray of int, shape (n,)
+        17, 18 or 19.
+    clockwise : ndarray of bool, shape (n,)
+    length : ndarray, shape (n,)
+        Path length of each arc; with the rise along the helix axis it gives
+        the swept angle, full turns included.
+    max_angle : float, default: 5 degrees
+        Largest angle between two points, radians.
+
+    Returns
+    -------
+    points : ndarray, shape (m, 3)
+        The interior points of every arc in order, neither start nor end.
+    counts : ndarray of int, shape (n,)
+        How many of them each arc has.
+    """
+    n = start.shape[0]
+    if n == 0:
+        return np.zeros((0, 3)), np.zeros(0, np.int64)
+    axes = np.array([PLANES[p][0] for p in PLANE_CODES])[np.asarray(plane, np.int64) - 17]
+    arc = np.arange(n)
+    f, g, h = axes[:, 0], axes[:, 1], axes[:, 2]
+    d_f, d_g = start[arc, f] - center[arc, f], start[arc, g] - center[arc, g]
+    radius = np.hypot(d_f, d_g)
+    rise = end[arc, h] - start[arc, h]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        angle = np.sqrt(np.maximum(np.asarray(length, float) ** 2 - rise**2, 0.0)) / radius
+    angle = np.where(np.isfinite(angle) & (radius > 0), angle, 0.0)
+    steps = np.clip(np.ceil(angle / max_angle), 1, 2000).astype(np.int64)
+    counts = steps - 1
+    which = np.repeat(arc, counts)
+    # j = 1 .. steps-1 within each arc
+    j = np.arange(which.size) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+    t = j / steps[which]
+    theta = np.arctan2(d_g, d_f)[which] + np.where(clockwise[which], -1.0, 1.0) * t * angle[which]
+    points = np.empty((which.size, 3))
+    rows = np.arange(which.size)
+    points[rows, f[which]] = center[which, f[which]] + radius[which] * np.cos(theta)
+    points[rows, g[which]] = center[which, g[which]] + radius[which] * np.sin(theta)
+    points[rows, h[which]] = start[which, h[which]] + t * rise[which]
+    return points, counts
+
+
+def waypoint_arc_points(w: dict, rows: np.ndarray, max_angle: float = np.radians(5.0)):
+    """:func:`interior_points` of the waypoints ``rows`` (each a move from the waypoint before it).
+
+    Returns the points and, per row, how many (0 for straight moves).
+    """
+    motion = np.asarray(w["motion"])[rows]
+    arc = np.flatnonzero((motion == 3) | (motion == 4))
+    counts = np.zeros(rows.size, np.int64)
+    if arc.size == 0:
+        return np.zeros((0, 3)), counts
+    end_rows = rows[arc]
+    xyz = lambda r: np.column_stack([np.asarray(w[k], float)[r] for k in "xyz"])  # noqa: E731
+    center = np.column_stack([np.asarray(w[k], float)[end_rows] for k in ("cx", "cy", "cz")])
+    points, counts[arc] = interior_points(xyz(end_rows - 1), xyz(end_rows), center, np.asarray(w["plane"])[end_rows],
+                                          motion[arc] == 3, np.asarray(w["distance"], float)[end_rows], max_angle)
+    return points, counts

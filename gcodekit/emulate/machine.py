@@ -45,6 +45,7 @@ SMALL_COLUMNS = {
     "coolant": (np.uint8, "bit 1 mist, bit 2 flood"),
     "laser": (np.uint8, "1 while the laser/weld heat source is on (DED: M61 on, M62 off)"),
     "work_offset": (np.uint8, "1..9 for G54..G59.3"),
+    "flow": (np.float32, "extrusion multiplier in force (M221), ratio: de is the programmed E times it"),
 }
 _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTRUDE, Kind.MOVE_MILL,
                            Kind.ARC_MILL, Kind.EXTRUDE}), np.uint8)
@@ -234,6 +235,7 @@ class Machine:
         out["coolant"][rows] = s.coolant
         out["laser"][rows] = s.laser
         out["work_offset"][rows] = s.work_offset
+        out["flow"][rows] = s.flow
 
     # -- runs of plain commands ---------------------------------------------------
 

@@ -379,19 +379,36 @@ class AdditiveOperation(Operation):
         d = self.machine.filament_diameter if self.machine else 1.75
         return float(np.pi * d * d / 4.0)
 
+    def deposited_volumes(self) -> np.ndarray:
+        """Material laid by each waypoint (mm^3).
+
+        Filament machines: E pushed times the filament's cross-section.  Screw
+        extruders (BAAM, CEAD): rpm x minutes x the screw's displacement per
+        revolution while the screw turns on a feed move; NaN when the machine
+        does not give its displacement.  Wire and powder (DED): unknown, NaN.
+        """
+        w = self.waypoints
+        kind = self.machine.extruder_type if self.machine else "filament"
+        if kind == "filament":
+            return np.asarray(w["de"], float) * self.filament_area
+        if kind == "screw":
+            turning = (np.asarray(w["spindle"]) > 0) & (np.asarray(w["motion"]) >= 2)
+            per_rev = self.machine.screw_displacement * 1000.0 or np.nan  # cm^3 -> mm^3
+            minutes = np.nan_to_num(np.asarray(w["time"], float)) / 60.0
+            return np.where(turning, np.asarray(w["spindle"], float) * minutes * per_rev, 0.0)
+        return np.where(np.asarray(w.get("laser", np.zeros(len(w["x"])))) == 1, np.nan, 0.0)
+
     def _process_fields(self, k: int) -> dict[str, Any]:
         fields = super()._process_fields(k)
         w = self.waypoints
-        screw = self.machine is not None and self.machine.extruder == "screw"
-        if screw:  # rpm x minutes x cm^3 per revolution, while the screw turns on a feed move
-            turning = w["spindle"][k] > 0 and w["motion"][k] >= 2
-            per_rev = self.machine.screw_displacement * 1000.0 or np.nan  # mm^3; unknown when not given
-            volume = float(w["spindle"][k] * np.nan_to_num(w["time"][k]) / 60.0 * per_rev) if turning else 0.0
-        else:
+        kind = self.machine.extruder_type if self.machine else "filament"
+        if kind == "filament":
             volume = float(w["de"][k]) * self.filament_area
+        else:
+            volume = float(self.deposited_volumes()[k])
         distance = fields["distance"]
         fields.update(deposited_volume=volume, bead_area=volume / distance if distance > 0 and volume > 0 else 0.0,
-                      extruder_type="screw" if screw else "filament")
+                      extruder_type=kind)
         return fields
 
 

@@ -32,7 +32,7 @@ _CHOICES = {
     "tool_table_units": ("mm", "inch"),
     "cycle_retract": ("initial", "r"),
     "table_axis": ("", "W"),
-    "extruder": ("filament", "screw"),
+    "extruder_type": ("filament", "screw", "wire", "powder"),
 }
 
 
@@ -77,6 +77,10 @@ class MachineConfig:
         mm; turns extruded length into volume.
     filament_density : float
         g/cm^3; turns volume into mass.
+    extruder_type : {"filament", "screw", "wire", "powder"}
+        How material reaches the bead: filament drive (FFF), pellet screw
+        (LFAM: BAAM, CEAD; it turns at the spindle speed S while the
+        spindle is on, M3), wire or powder feed (DED).
     work_offsets : mapping of str to list of float
         Initial G54-G59.3 offsets in mm, e.g. ``G55 = [100, 0, 0]``.
     retract_length, unretract_extra_length : float
@@ -105,9 +109,6 @@ class MachineConfig:
         An axis that moves the build table up and down (BAAM's W): the part
         frame's height is then Z - W, so a table drop between layers is a
         layer change.  Absolute positioning only.
-    extruder : {"filament", "screw"}
-        What deposits: filament pushed by E, or a screw extruder (BAAM,
-        CEAD) turning at the spindle speed S while the spindle is on (M3).
     screw_displacement : float
         cm^3 of material a screw extruder delivers per revolution; 0 leaves
         its deposited volume unknown (NaN).
@@ -129,6 +130,7 @@ class MachineConfig:
     block_delete: bool = False
     filament_diameter: float = 1.75
     filament_density: float = 1.24
+    extruder_type: str = "filament"
     work_offsets: Mapping[str, tuple[float, ...]] = field(default_factory=lambda: MappingProxyType({}))
     retract_length: float = 0.0
     retract_speed: float = 20.0
@@ -142,7 +144,6 @@ class MachineConfig:
     spline_tolerance: float = 0.001
     cycle_retract: str = "initial"
     table_axis: str = ""
-    extruder: str = "filament"
     screw_displacement: float = 0.0
 
     def __hash__(self) -> int:
