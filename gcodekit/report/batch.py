@@ -32,6 +32,9 @@ class ReportOptions:
         Also write the executed notebook ``name.ipynb``.
     notebook_html : bool, default: False
         Also convert that notebook to ``name.notebook.html``.
+    strict : bool, default: False
+        A program with an error gets an error page naming its line, instead
+        of a report listing the error among its diagnostics.
     """
 
     machine: str | None = None
@@ -39,6 +42,7 @@ class ReportOptions:
     pdf: bool = True
     notebook: bool = False
     notebook_html: bool = False
+    strict: bool = False
 
 
 def output_names(paths: Sequence[str | os.PathLike]) -> list[str]:
@@ -76,7 +80,7 @@ def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: st
     """
     from .build import key_figures, report_data
     from .figures import report_figures
-    from .html import error_page, program_page
+    from .html import program_page
     from ..pipeline import gcode_to_operation
 
     path, out_dir = Path(path), Path(out_dir)
@@ -87,7 +91,8 @@ def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: st
     try:
         if not path.is_file():
             raise FileNotFoundError(f"no such program file: {path}")
-        op = gcode_to_operation(path, options.machine, machine_config=options.machine_config)
+        op = gcode_to_operation(path, options.machine, machine_config=options.machine_config,
+                                mode="strict" if options.strict else "lenient")
         data = report_data(op)
         html_path.write_text(program_page(data, report_figures(op, data)), encoding="utf-8")
         row.update(key_figures(data))

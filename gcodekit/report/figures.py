@@ -30,6 +30,8 @@ MAX_2D_SEGMENTS = 120_000
 #: Chords per arc: 16 keeps a 100 mm arc within 0.5 mm of the circle at report scale.
 ARC_CHORDS = 16
 THUMBNAILS = 12
+#: The pictures of a report page.
+FIGURES = ("iso", "top", "layer_times", "thumbnails", "velocity", "breakdown")
 DPI = 100
 WIDTH_IN = 8.0
 
@@ -192,7 +194,12 @@ def toolpath_iso(seg: Segments) -> "Figure":
     ax.set_xlim(lo[0], lo[0] + span[0])
     ax.set_ylim(lo[1], lo[1] + span[1])
     ax.set_zlim(lo[2], lo[2] + span[2])
-    ax.set_box_aspect(span)
+    # equal scales, except that a flat part (a mill pass, a first layer) keeps a readable height
+    ax.set_box_aspect((span[0], span[1], max(span[2], 0.25 * max(span[0], span[1]))))
+    from matplotlib.ticker import MaxNLocator
+
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(6))
     ax.view_init(elev=35.264, azim=-45)  # isometric: arctan(1/sqrt 2) above the XY diagonal
     ax.set_xlabel("X, mm")
     ax.set_ylabel("Y, mm")
@@ -332,12 +339,12 @@ def data_uri(fig: "Figure") -> str:
 
 
 def report_figures(op: "Operation", data: dict[str, Any]) -> dict[str, str]:
-    """Every picture of a report as a ``data:`` URI, keyed by name; absent ones are left out."""
+    """Every picture of a report as a ``data:`` URI, keyed by the names in :data:`FIGURES` (None when absent)."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)  # off-screen even when a display is set
     seg = toolpath_segments(op)
-    figures: dict[str, Any] = {}
+    figures: dict[str, Any] = dict.fromkeys(FIGURES)
     if seg.start.shape[0]:
         figures["iso"] = toolpath_iso(seg)
         figures["top"] = toolpath_top(seg)
@@ -346,4 +353,4 @@ def report_figures(op: "Operation", data: dict[str, Any]) -> dict[str, str]:
         figures["thumbnails"] = layer_thumbnails(seg) if seg.start.shape[0] else None
     figures["velocity"] = velocity(op)
     figures["breakdown"] = breakdown_chart(data["breakdown"])
-    return {name: data_uri(fig) for name, fig in figures.items() if fig is not None}
+    return {name: None if fig is None else data_uri(fig) for name, fig in figures.items()}
