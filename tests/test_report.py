@@ -92,6 +92,16 @@ def test_arcs_are_drawn_as_chords_on_their_circle():
     assert angles[-1] - angles[0] == pytest.approx(2 * np.pi)  # counter-clockwise, once round
 
 
+def test_only_depositing_arcs_are_drawn_in_a_print():
+    program = "M83\nG1 Z0.2 F600\nG2 X10 Y0 I5 J0 E1 F1200\nG2 X0 Y0 I-5 J0\nG3 X10 Y0 I5 J0 E1\n"
+    op = gcodekit.gcode_to_operation(program, machine="marlin")
+    seg = toolpath_segments(op)
+    assert seg.start.shape[0] == 2 * ARC_CHORDS  # the travel arc between them is left out
+    assert np.allclose(np.hypot(seg.end[:, 0] - 5, seg.end[:, 1]), 5.0)
+    # left to right, clockwise passes above the centre and counter-clockwise below
+    assert (seg.end[:ARC_CHORDS, 1] >= -1e-9).all() and (seg.end[ARC_CHORDS:, 1] <= 1e-9).all()
+
+
 def test_comments_and_file_names_are_escaped(tmp_path):
     bad = "<script>alert(1)</script>"
     program = tmp_path / "<script>alert(1).gcode"
@@ -222,7 +232,7 @@ def test_html_loads_in_chromium_without_console_errors(tmp_path, print_file):
     messages, _ = chromium_console(broken)
     assert any("boom" in m for m in messages) and any("nosuch" in m for m in messages)  # the probe hears errors
 
-    rows = write_reports([print_file, MILL], tmp_path / "out", options=ReportOptions(pdf=False))
+    rows = write_reports([print_file], tmp_path / "out", options=ReportOptions(pdf=False))
     for page in [tmp_path / "out" / "index.html"] + [tmp_path / "out" / r["html"] for r in rows]:
         messages, dom = chromium_console(page)
         assert messages == [], page.name

@@ -25,8 +25,8 @@ if TYPE_CHECKING:
     from ..emulate.operation import Operation
 
 #: Segments drawn in the 3D view and the top view (beyond this they only add ink).
-MAX_3D_SEGMENTS = 40_000
-MAX_2D_SEGMENTS = 120_000
+MAX_3D_SEGMENTS = 25_000
+MAX_2D_SEGMENTS = 60_000
 #: Chords per arc: 16 keeps a 100 mm arc within 0.5 mm of the circle at report scale.
 ARC_CHORDS = 16
 THUMBNAILS = 12
@@ -88,7 +88,7 @@ def toolpath_segments(op: "Operation") -> Segments:
     arcs = np.isin(np.asarray(w["motion"])[idx], (3, 4))
     if arcs.any():
         a = idx[arcs]
-        pts = _arc_points(w, prev[a], xyz[a])  # (m, ARC_CHORDS + 1, 3)
+        pts = _arc_points(w, a, prev[a], xyz[a])  # (m, ARC_CHORDS + 1, 3)
         arc_start = pts[:, :-1].reshape(-1, 3)
         arc_end = pts[:, 1:].reshape(-1, 3)
         straight = idx[~arcs]
@@ -101,11 +101,10 @@ def toolpath_segments(op: "Operation") -> Segments:
     return Segments(start, end, np.asarray(value)[owner], np.asarray(layer)[owner], rapid, labels)
 
 
-def _arc_points(w: dict, start: np.ndarray, end: np.ndarray) -> np.ndarray:
-    """Points along arcs (plane from ``plane``, centre ``cx, cy, cz``), helix axis interpolated."""
+def _arc_points(w: dict, rows: np.ndarray, start: np.ndarray, end: np.ndarray) -> np.ndarray:
+    """Points along the arcs ending at waypoints ``rows`` (plane from ``plane``, centre
+    ``cx, cy, cz``), the helix axis interpolated."""
     motion = np.asarray(w["motion"])
-    mask = np.isin(motion, (3, 4)) & (np.asarray(w["distance"]) > 0)
-    rows = np.flatnonzero(mask)
     center = np.column_stack([w["cx"], w["cy"], w["cz"]]).astype(float)[rows]
     plane = np.asarray(w["plane"])[rows]
     out = np.empty((rows.size, ARC_CHORDS + 1, 3))
