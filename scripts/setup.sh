@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Create .venv and install gcodekit with its test tools, once per change of
-# pyproject.toml.  Sourced by run-examples.sh and run-tests.sh.
+# Create .venv and install gcodekit with its test and report tools, once per
+# change of pyproject.toml; install Chromium (PDF reports) and poppler-utils
+# (the PDF test) with apt-get when missing.  Sourced by run-examples.sh and
+# run-tests.sh.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 VENV="$ROOT/.venv"
@@ -22,6 +24,21 @@ if [ ! -x "$VENV/bin/python" ]; then
     else
       die "cannot create a virtual environment; install the python3-venv package"
     fi
+  fi
+fi
+
+# Debian packages the reports need: chromium prints the PDFs, pdftoppm (poppler-utils) checks them in the tests.
+missing=()
+command -v chromium >/dev/null || command -v chromium-browser >/dev/null || command -v google-chrome >/dev/null \
+  || missing+=(chromium)
+command -v pdftoppm >/dev/null || missing+=(poppler-utils)
+if [ ${#missing[@]} -gt 0 ]; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    echo "gcodekit setup: installing ${missing[*]} with apt-get" >&2
+    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null; } \
+      || die "apt-get could not install ${missing[*]}"
+  else
+    die "PDF reports need ${missing[*]}: install them (apt-get install ${missing[*]}) as root, then run this again"
   fi
 fi
 
