@@ -43,6 +43,7 @@ def run_report(programs: list[Path], workers: int, repeat: int) -> float:
         with tempfile.TemporaryDirectory() as out:
             cmd = [sys.executable, "-m", "gcodekit.cli", "report", *map(str, programs), "-o", out,
                    "--workers", str(workers), "--no-progress"]
+            print(f"    (load average {os.getloadavg()[0]:.1f} before a run with {workers} worker(s))")
             start = time.perf_counter()
             done = subprocess.run(cmd, capture_output=True, text=True)
             elapsed = time.perf_counter() - start

@@ -76,7 +76,7 @@ def toolpath_segments(op: "Operation") -> Segments:
         names = features(op)
         if np.any(names != ""):
             labels, value = np.unique(names, return_inverse=True)
-            labels = [str(x) or "other" for x in labels]
+            labels = [str(x) or "(no feature)" for x in labels]
         else:
             value = np.asarray(w["feed"], float) / 60.0
         layer = layers(op)
@@ -161,12 +161,13 @@ def _colours(seg: Segments):
     return colours, ("colorbar", mpl.cm.ScalarMappable(norm=norm, cmap="viridis"))
 
 
-def _key(fig: "Figure", ax, key) -> None:
+def _key(fig: "Figure", ax, key, seg: Segments) -> None:
     kind, what = key
+    shown = set(np.unique(seg.value).astype(int).tolist()) if kind == "legend" else set()
     if kind == "legend":
         from matplotlib.lines import Line2D
 
-        handles = [Line2D([], [], color=c, lw=3, label=lab) for lab, c in what]
+        handles = [Line2D([], [], color=c, lw=3, label=lab) for k, (lab, c) in enumerate(what) if k in shown]
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
     else:
         fig.colorbar(what, ax=ax, shrink=0.7, pad=0.08, label="commanded speed, mm/s")
@@ -179,9 +180,16 @@ def _figure(height: float) -> "Figure":
 
 
 def toolpath_iso(seg: Segments) -> "Figure":
-    """Isometric 3D view of the toolpath (orthographic, equal axes)."""
+    """Isometric 3D view of the toolpath (orthographic, equal axes).
+
+    A print shows its layers only: a purge line drawn before the first layer
+    would otherwise shrink the part to a corner of the picture (the top view
+    shows it).
+    """
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
+    if (seg.layer >= 0).any():
+        seg = seg.take(seg.layer >= 0)
     seg = _thin(seg, MAX_3D_SEGMENTS, by_layer=True)
     fig = _figure(5.0)
     ax = fig.add_subplot(projection="3d", proj_type="ortho")
@@ -204,7 +212,7 @@ def toolpath_iso(seg: Segments) -> "Figure":
     ax.set_ylabel("Y, mm")
     ax.set_zlabel("Z, mm")
     ax.tick_params(labelsize=7)
-    _key(fig, ax, key)
+    _key(fig, ax, key, seg)
     return fig
 
 
@@ -223,7 +231,7 @@ def toolpath_top(seg: Segments) -> "Figure":
     ax.set_xlabel("X, mm")
     ax.set_ylabel("Y, mm")
     ax.set_title("Top view", fontsize=10)
-    _key(fig, ax, key)
+    _key(fig, ax, key, seg)
     return fig
 
 
