@@ -199,11 +199,11 @@ def _text(r: dict[str, Any]) -> str:
 
 
 def _duration(seconds: float) -> str:
+    from .report.html import duration
+
     if seconds != seconds:
         return "unknown"
-    h, rest = divmod(int(round(seconds)), 3600)
-    mnt, s = divmod(rest, 60)
-    return f"{h}:{mnt:02d}:{s:02d} ({seconds:.1f} s)"
+    return f"{duration(seconds)} ({seconds:.1f} s)"
 
 
 def _export(args: argparse.Namespace) -> int:
@@ -248,6 +248,12 @@ def _report(args: argparse.Namespace) -> int:
     if args.notebook_html and not args.notebook:
         print("gcodekit: error: --notebook-html needs --notebook", file=sys.stderr)
         return 2
+    if args.machine:  # a wrong name fails once here, not once per program
+        from .emulate.presets import load_machine
+
+        load_machine(args.machine)
+    if args.machine_config and not os.path.isfile(args.machine_config):
+        raise FileNotFoundError(f"no such machine config file: {args.machine_config}")
     if not args.no_pdf:
         from .report.pdf import ChromiumNotFound, find_chromium
 

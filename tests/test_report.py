@@ -165,6 +165,12 @@ def test_cli_never_overwrites_without_force(tmp_path, print_file, capsys):
     assert "<h1>tiny.gcode</h1>" in mine.read_text()
 
 
+def test_cli_rejects_a_wrong_machine_before_writing_anything(tmp_path, print_file, capsys):
+    assert cli.main(["report", str(print_file), "-o", str(tmp_path / "out"), "--no-pdf", "--machine", "marlinn"]) == 2
+    assert "did you mean 'marlin'" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
 def test_report_package_imports_nothing_heavy():
     code = ("import sys, gcodekit.report, gcodekit.report.build, gcodekit.report.figures\n"
             "print([m for m in ('matplotlib', 'jinja2', 'nbclient', 'distributed') if m in sys.modules])")

@@ -85,8 +85,7 @@ def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: st
 
     path, out_dir = Path(path), Path(out_dir)
     name = name or output_names([path])[0]
-    row: dict[str, Any] = {"name": path.name, "file": str(path), "html": f"{name}.html", "pdf": None,
-                           "error": None}
+    row = _row(path, name)
     html_path = out_dir / row["html"]
     try:
         if not path.is_file():
@@ -115,6 +114,10 @@ def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: st
         except Exception as exc:  # noqa: BLE001
             row["error"] = f"notebook: {exc}"
     return row
+
+
+def _row(path: Path, name: str) -> dict[str, Any]:
+    return {"name": path.name, "file": str(path), "html": f"{name}.html", "pdf": None, "error": None}
 
 
 def _failed(row: dict[str, Any], html_path: Path, exc: BaseException) -> dict[str, Any]:
@@ -208,5 +211,5 @@ def _result(future, job: tuple) -> dict[str, Any]:
         return future.result()
     except Exception as exc:  # noqa: BLE001 -- a worker that died takes only its own program down
         path, out, name, _ = job
-        row = {"name": Path(path).name, "file": path, "html": f"{name}.html", "pdf": None, "error": None}
+        row = _row(Path(path), name)
         return _failed(row, Path(out) / row["html"], exc)
