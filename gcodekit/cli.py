@@ -262,7 +262,8 @@ def _report(args: argparse.Namespace) -> int:
         except ChromiumNotFound as exc:
             print(f"gcodekit: error: {exc}", file=sys.stderr)
             return 2
-    options = ReportOptions(machine=args.machine, machine_config=args.machine_config, pdf=not args.no_pdf,
+    config = os.path.abspath(args.machine_config) if args.machine_config else None
+    options = ReportOptions(machine=args.machine, machine_config=config, pdf=not args.no_pdf,
                             notebook=args.notebook, notebook_html=args.notebook_html, strict=args.strict)
     rows = write_reports(args.files, args.output, options=options, workers=args.workers, dask=args.dask,
                          progress=sys.stderr.isatty() and not args.no_progress, force=args.force)
