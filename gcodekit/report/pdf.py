@@ -40,8 +40,12 @@ def find_chromium() -> str:
 
 
 def chromium_command(*args: str, profile: str) -> list[str]:
-    """A headless Chromium command line; no sandbox because reports often run as root in containers."""
-    return [find_chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+    """A headless Chromium command line.
+
+    No sandbox, because reports often run as root in containers, whose small
+    ``/dev/shm`` Chromium is also told not to rely on.
+    """
+    return [find_chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--no-first-run",
             "--disable-extensions", f"--user-data-dir={profile}", *args]
 
 
