@@ -172,7 +172,7 @@ def write_reports(paths: Sequence[str | os.PathLike], out_dir: str | os.PathLike
         raise FileExistsError(f"{out} already holds {shown}; use --force to overwrite")
     out.mkdir(parents=True, exist_ok=True)
     # absolute paths: a Dask worker may run in another directory (it must see the same file system)
-    jobs = [(str(Path(p).absolute()), str(out.absolute()), n, options) for p, n in zip(paths, names)]
+    jobs = [(os.path.abspath(p), os.path.abspath(out), n, options) for p, n in zip(paths, names)]
     jobs.sort(key=lambda j: os.path.getsize(j[0]) if os.path.isfile(j[0]) else 0, reverse=True)
     rows: dict[str, dict[str, Any]] = {}
     with tqdm(total=len(jobs), unit="program", disable=not progress, desc="reports") as bar:
