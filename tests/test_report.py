@@ -32,7 +32,7 @@ def tiny_print(layers: int = 3, comment: str = "") -> str:
     lines = ["; tiny print" + comment, "M83", "G21 G90", "G1 Z0.2 F600"]
     for k in range(layers):
         z = 0.2 * (k + 1)
-        lines += [f";LAYER_CHANGE", f";Z:{z:.1f}", f"G1 Z{z:.1f} F600", "G0 X0 Y0 F6000", ";TYPE:Perimeter",
+        lines += [";LAYER_CHANGE", f";Z:{z:.1f}", f"G1 Z{z:.1f} F600", "G0 X0 Y0 F6000", ";TYPE:Perimeter",
                   "G1 X10 Y0 E0.5 F1800", "G1 X10 Y10 E0.5", "G1 X0 Y10 E0.5", "G1 X0 Y0 E0.5",
                   ";TYPE:Internal infill", "G1 X10 Y10 E0.7 F3000"]
     return "\n".join(lines) + "\n"
