@@ -221,6 +221,8 @@ def velocity_profile(op: "Operation") -> "pd.DataFrame":
             "planned": np.repeat(speed, 2), "commanded": np.repeat(speed, 2), "line": np.repeat(line, 2),
         })
     moves, r = plan
+    if len(moves) == 0:  # nothing moved: no trapezoids to lay out
+        return pd.DataFrame({c: np.zeros(0) for c in ("time", "distance", "planned", "commanded", "line")})
     w = op.waypoints
     # a move starts when its waypoint started plus the moves of that waypoint before it
     dur = r.duration_t

@@ -1,4 +1,4 @@
-"""Command line: ``gcodekit info``, ``export``, ``render`` and ``translate``.
+"""Command line: ``gcodekit info``, ``export``, ``render``, ``translate`` and ``report``.
 
 Examples
 --------
@@ -9,6 +9,7 @@ Examples
     gcodekit export part.ngc --to csv -o part.csv
     gcodekit export print.gcode --to vtk -o print.vtp
     gcodekit render print.gcode -o print.png --color-by speed --view top
+    gcodekit report *.gcode -o reports/ --workers 2
 """
 
 from __future__ import annotations
@@ -73,7 +74,30 @@ def _parser() -> argparse.ArgumentParser:
     translate.add_argument("--to", metavar="FLAVOR", help="write in this dialect (default: rs274ngc)")
     translate.add_argument("-o", "--output", metavar="OUT", help="output file (default: standard output)")
     translate.add_argument("-f", "--force", action="store_true", help="overwrite OUT if it exists")
+
+    report = sub.add_parser("report", help="an HTML and PDF report per program, and an index page")
+    report.add_argument("files", nargs="+", metavar="PROGRAM")
+    report.add_argument("-o", "--output", required=True, metavar="DIR", help="directory for the reports")
+    report.add_argument("--machine", help="machine preset (default: the one for the flavor)")
+    report.add_argument("--machine-config", metavar="FILE",
+                        help="the firmware's own settings for the machine's planner (Klipper printer.cfg)")
+    report.add_argument("--workers", type=_positive, default=1, metavar="N", help="worker processes (default: 1)")
+    report.add_argument("--dask", metavar="ADDRESS", help="run on the Dask scheduler at ADDRESS instead")
+    report.add_argument("--no-pdf", action="store_true", help="write the HTML pages only")
+    report.add_argument("--notebook", action="store_true", help="also write each report as an executed notebook")
+    report.add_argument("--notebook-html", action="store_true", help="with --notebook: also convert it to HTML")
+    report.add_argument("--strict", action="store_true",
+                        help="a program with an error gets an error page instead of a report")
+    report.add_argument("-f", "--force", action="store_true", help="overwrite existing reports in DIR")
+    report.add_argument("--no-progress", action="store_true", help="never show a progress bar")
     return p
+
+
+def _positive(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"needs 1 or more, not {value}")
+    return value
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -95,8 +119,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _translate(args)
         if args.command == "render":
             return _render(args)
+        if args.command == "report":
+            return _report(args)
         return _export(args)
-    except (GcodeError, FileNotFoundError, IsADirectoryError, PermissionError, ValueError, ImportError) as exc:
+    except (GcodeError, FileNotFoundError, FileExistsError, IsADirectoryError, PermissionError, ValueError,
+            ImportError) as exc:
         print(f"gcodekit: error: {exc}", file=sys.stderr)
         return 1 if isinstance(exc, GcodeError) and not isinstance(exc, ConfigError) else 2
     except BrokenPipeError:
@@ -202,11 +229,11 @@ def _text(r: dict[str, Any]) -> str:
 
 
 def _duration(seconds: float) -> str:
+    from .report.html import duration
+
     if seconds != seconds:
         return "unknown"
-    h, rest = divmod(int(round(seconds)), 3600)
-    mnt, s = divmod(rest, 60)
-    return f"{h}:{mnt:02d}:{s:02d} ({seconds:.1f} s)"
+    return f"{duration(seconds)} ({seconds:.1f} s)"
 
 
 def _exists(path: str | None, args: argparse.Namespace) -> bool:
@@ -297,6 +324,39 @@ def _translate(args: argparse.Namespace) -> int:
         sys.stdout.write(text)
     _report_errors(op)
     return 0
+
+
+def _report(args: argparse.Namespace) -> int:
+    from .report import ReportOptions, write_reports
+
+    if args.notebook_html and not args.notebook:
+        print("gcodekit: error: --notebook-html needs --notebook", file=sys.stderr)
+        return 2
+    if args.machine:  # a wrong name fails once here, not once per program
+        from .emulate.presets import load_machine
+
+        load_machine(args.machine)
+    if args.machine_config and not os.path.isfile(args.machine_config):
+        raise FileNotFoundError(f"no such machine config file: {args.machine_config}")
+    if not args.no_pdf:
+        from .report.pdf import ChromiumNotFound, find_chromium
+
+        try:
+            find_chromium()
+        except ChromiumNotFound as exc:
+            print(f"gcodekit: error: {exc}", file=sys.stderr)
+            return 2
+    config = os.path.abspath(args.machine_config) if args.machine_config else None
+    options = ReportOptions(machine=args.machine, machine_config=config, pdf=not args.no_pdf,
+                            notebook=args.notebook, notebook_html=args.notebook_html, strict=args.strict)
+    rows = write_reports(args.files, args.output, options=options, workers=args.workers, dask=args.dask,
+                         progress=sys.stderr.isatty() and not args.no_progress, force=args.force)
+    for r in rows:
+        if r["error"]:
+            print(f"gcodekit: {r['file']}: {r['error']}", file=sys.stderr)
+    failed = sum(1 for r in rows if r["error"])
+    print(f"{len(rows) - failed} of {len(rows)} reports written to {os.path.join(args.output, 'index.html')}")
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The main job: emulate every bundled example and write its summary (text and
-# JSON), motion table and picture into out/examples/, and for additive programs
-# a VTK mesh and an Abaqus event series.
+# The main job: report every bundled example (HTML and PDF per program, and
+# out/reports/index.html), and write its summary (text and JSON), motion table
+# and picture into out/examples/, and for additive programs a VTK mesh and an
+# Abaqus event series.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 source "$ROOT/scripts/setup.sh"
@@ -19,4 +20,6 @@ for program in "$ROOT"/examples/*.*; do
     "$VENV/bin/gcodekit" export "$program" --to events -o "$OUT/$name.events.csv" --force
   fi
 done
+"$VENV/bin/gcodekit" report "$ROOT"/examples/*.* -o "$ROOT/out/reports" --workers 2 --force
 echo "summaries, motion tables, pictures, VTK meshes and event series written to $OUT"
+echo "reports written to $ROOT/out/reports (open index.html)"

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Create .venv and install gcodekit with its test tools, once per change of
-# pyproject.toml.  Sourced by run-examples.sh and run-tests.sh.
+# Create .venv and install gcodekit with its test and report tools, once per
+# change of pyproject.toml; install Chromium (PDF reports) and poppler-utils
+# (the PDF test) with apt-get when missing.  Sourced by run-examples.sh and
+# run-tests.sh.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 VENV="$ROOT/.venv"
@@ -25,14 +27,22 @@ if [ ! -x "$VENV/bin/python" ]; then
   fi
 fi
 
-# Off-screen pictures (VTK through EGL) need Mesa's EGL and software renderer.
-if ! { compgen -G '/usr/lib/*/libEGL.so.1' >/dev/null && [ -e /usr/share/glvnd/egl_vendor.d/50_mesa.json ]; }; then
+# Debian packages: Mesa's EGL and software renderer draw the off-screen 3D
+# pictures (VTK through EGL), chromium prints the PDF reports and pdftoppm
+# (poppler-utils) checks them in the tests.
+missing=()
+compgen -G '/usr/lib/*/libEGL.so.1' >/dev/null && [ -e /usr/share/glvnd/egl_vendor.d/50_mesa.json ] \
+  || missing+=(libegl1 libegl-mesa0 libgl1-mesa-dri)
+command -v chromium >/dev/null || command -v chromium-browser >/dev/null || command -v google-chrome >/dev/null \
+  || missing+=(chromium)
+command -v pdftoppm >/dev/null || missing+=(poppler-utils)
+if [ ${#missing[@]} -gt 0 ]; then
   if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
-    echo "gcodekit setup: installing Mesa EGL (libegl1 libegl-mesa0 libgl1-mesa-dri) for off-screen pictures" >&2
-    { apt-get update -qq && apt-get install -y -qq libegl1 libegl-mesa0 libgl1-mesa-dri >/dev/null; } \
-      || echo "gcodekit setup: warning: apt-get could not install Mesa EGL; 3D pictures will fail" >&2
+    echo "gcodekit setup: installing ${missing[*]} with apt-get" >&2
+    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null; } \
+      || die "apt-get could not install ${missing[*]}"
   else
-    echo "gcodekit setup: warning: 3D pictures need Mesa EGL (apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri)" >&2
+    die "pictures and PDF reports need ${missing[*]}: install them (apt-get install ${missing[*]}) as root, then run this again"
   fi
 fi
 

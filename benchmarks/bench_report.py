@@ -1,0 +1,87 @@
+"""Benchmark: the report of a large print, and a batch on one worker against two.
+
+The acceptance benchmark of the report issue:
+
+* the full report (HTML and PDF) of ``cylinder_marlin2.gcode`` (147 k
+  lines) within 10 s, command start to PDF written (imports included);
+* the FFF corpus (``../shared/corpus/fff/*.gcode``; ``--with-gz`` adds the
+  3.1 M-line plate) reported with 2 worker processes at least 1.6x faster
+  than with 1, PDFs included.
+
+Every measurement is the ``gcodekit report`` command in a fresh interpreter,
+as a user runs it; each is repeated, the one- and two-worker runs taking
+turns, and the best time counts (the machine is shared with other jobs).
+
+Examples
+--------
+::
+
+    python benchmarks/bench_report.py            # two or three minutes on 2 cores
+    python benchmarks/bench_report.py --with-gz  # adds the 3.1 M-line plate to the batch
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "fff"
+CYLINDER = CORPUS / "cylinder_marlin2.gcode"
+MAX_REPORT_S = 10.0
+MIN_SPEEDUP = 1.6
+
+
+def run_report(programs: list[Path], workers: int, repeat: int) -> float:
+    """Best wall time of ``gcodekit report PROGRAMS --workers N`` into a fresh directory."""
+    best = float("inf")
+    for _ in range(repeat):
+        with tempfile.TemporaryDirectory() as out:
+            cmd = [sys.executable, "-m", "gcodekit.cli", "report", *map(str, programs), "-o", out,
+                   "--workers", str(workers), "--no-progress"]
+            print(f"    (load average {os.getloadavg()[0]:.1f} before a run with {workers} worker(s))")
+            start = time.perf_counter()
+            done = subprocess.run(cmd, capture_output=True, text=True)
+            elapsed = time.perf_counter() - start
+            if done.returncode != 0:
+                sys.exit(f"gcodekit report failed:\n{done.stderr}")
+            if len(list(Path(out).glob("*.pdf"))) != len(programs):
+                sys.exit("gcodekit report wrote fewer PDFs than programs")
+        best = min(best, elapsed)
+    return best
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--with-gz", action="store_true", help="add the .gcode.gz programs to the batch")
+    p.add_argument("--repeat", type=int, default=3, help="runs per measurement, best counts (default: 3)")
+    args = p.parse_args()
+    if not CYLINDER.exists():
+        sys.exit(f"corpus not found: {CORPUS}")
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-c", "import gcodekit"], check=True)
+    print(f"import gcodekit (fresh interpreter, with start-up): {time.perf_counter() - start:.2f} s")
+
+    single = run_report([CYLINDER], 1, args.repeat)
+    print(f"report of {CYLINDER.name} (HTML + PDF): {single:.2f} s (limit {MAX_REPORT_S:.0f} s)")
+
+    batch = sorted(CORPUS.glob("*.gcode")) + (sorted(CORPUS.glob("*.gcode.gz")) if args.with_gz else [])
+    size = sum(f.stat().st_size for f in batch) / 1e6
+    print(f"batch: {len(batch)} programs, {size:.1f} MB, {os.cpu_count()} CPUs")
+    one = two = float("inf")
+    for _ in range(args.repeat):  # alternate, so both see the same share of a busy machine
+        one = min(one, run_report(batch, 1, 1))
+        two = min(two, run_report(batch, 2, 1))
+    ratio = one / two
+    print(f"  1 worker  {one:6.2f} s\n  2 workers {two:6.2f} s\n  speed-up  {ratio:.2f}x (at least {MIN_SPEEDUP}x)")
+    ok = single <= MAX_REPORT_S and ratio >= MIN_SPEEDUP
+    print("PASS" if ok else "FAIL")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,216 @@
+"""Report stage: reports of many programs, on worker processes or a Dask cluster.
+
+Each program is one job: emulate, draw, write its page (and PDF, and
+notebook).  A job never raises: a program that fails gets an error page and
+an error row, so one bad file never stops a batch.  Jobs are handed out
+largest file first, so two workers finish together rather than one waiting
+on the biggest program at the end.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterable, Sequence
+
+from ..errors import GcodeError
+
+
+@dataclass(frozen=True)
+class ReportOptions:
+    """How to report each program of a batch.
+
+    Parameters
+    ----------
+    machine, machine_config : as for :func:`gcodekit.gcode_to_operation`
+    pdf : bool, default: True
+        Print each page to PDF with headless Chromium.
+    notebook : bool, default: False
+        Also write the executed notebook ``name.ipynb``.
+    notebook_html : bool, default: False
+        Also convert that notebook to ``name.notebook.html``.
+    strict : bool, default: False
+        A program with an error gets an error page naming its line, instead
+        of a report listing the error among its diagnostics.
+    """
+
+    machine: str | None = None
+    machine_config: str | None = None
+    pdf: bool = True
+    notebook: bool = False
+    notebook_html: bool = False
+    strict: bool = False
+
+
+def output_names(paths: Sequence[str | os.PathLike]) -> list[str]:
+    """A distinct, file-system-safe base name per program (its file name, ``-2`` ... on a clash).
+
+    >>> output_names(["a/part.gcode", "b/part.gcode", "x<y>.nc", "index"])
+    ['part.gcode', 'part.gcode-2', 'x_y_.nc', 'index-2']
+    """
+    taken = {"index"}  # index.html is the batch's own page
+    names = []
+    for p in paths:
+        base = re.sub(r"[^A-Za-z0-9._-]", "_", Path(p).name).lstrip(".") or "program"
+        name, k = base, 1
+        while name in taken:
+            k += 1
+            name = f"{base}-{k}"
+        taken.add(name)
+        names.append(name)
+    return names
+
+
+def planned_outputs(names: Iterable[str], options: ReportOptions) -> list[str]:
+    """The files a batch writes into its directory, index included."""
+    suffixes = [".html"] + [".pdf"] * options.pdf + [".ipynb"] * options.notebook \
+        + [".notebook.html"] * (options.notebook and options.notebook_html)
+    return ["index.html"] + [name + s for name in names for s in suffixes]
+
+
+def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: str | None = None,
+                   options: ReportOptions = ReportOptions()) -> dict[str, Any]:
+    """Write the report of one program into ``out_dir``; return its index row.
+
+    A program that cannot be read or emulated gets an error page instead, and
+    its row an ``error``; this function does not raise for a bad program.
+    """
+    from .build import key_figures, report_data
+    from .figures import report_figures
+    from .html import program_page
+    from ..pipeline import gcode_to_operation
+
+    path, out_dir = Path(path), Path(out_dir)
+    name = name or output_names([path])[0]
+    row = _row(path, name)
+    html_path = out_dir / row["html"]
+    try:
+        if not path.is_file():
+            raise FileNotFoundError(f"no such program file: {path}")
+        op = gcode_to_operation(path, options.machine, machine_config=options.machine_config,
+                                mode="strict" if options.strict else "lenient")
+        data = report_data(op)
+        html_path.write_text(program_page(data, report_figures(op, data)), encoding="utf-8")
+        row.update(key_figures(data))
+    except Exception as exc:  # noqa: BLE001 -- any failure of one program becomes its error page
+        return _failed(row, html_path, exc)
+    if options.pdf:
+        from .pdf import html_to_pdf
+
+        try:
+            html_to_pdf(html_path, out_dir / f"{name}.pdf")
+            row["pdf"] = f"{name}.pdf"
+        except Exception as exc:  # noqa: BLE001 -- the page is written; say why its PDF is not
+            row["error"] = f"PDF: {exc}"
+    if options.notebook:
+        from .notebook import write_notebook
+
+        try:
+            write_notebook(path, out_dir / f"{name}.ipynb", machine=options.machine,
+                           machine_config=options.machine_config, html=options.notebook_html)
+        except Exception as exc:  # noqa: BLE001
+            row["error"] = f"notebook: {exc}"
+    return row
+
+
+def _row(path: Path, name: str) -> dict[str, Any]:
+    return {"name": path.name, "file": str(path), "html": f"{name}.html", "pdf": None, "error": None}
+
+
+def _failed(row: dict[str, Any], html_path: Path, exc: BaseException) -> dict[str, Any]:
+    from .html import error_page
+
+    row["error"] = str(exc) if isinstance(exc, (GcodeError, OSError)) else f"{type(exc).__name__}: {exc}"
+    html_path.write_text(error_page(row["name"], row["file"], exc), encoding="utf-8")
+    return row
+
+
+def _job(job: tuple[str, str, str, ReportOptions]) -> dict[str, Any]:
+    return report_program(*job)
+
+
+def write_reports(paths: Sequence[str | os.PathLike], out_dir: str | os.PathLike, *,
+                  options: ReportOptions = ReportOptions(), workers: int = 1, dask: str | None = None,
+                  progress: bool = False, force: bool = False) -> list[dict[str, Any]]:
+    """Report every program into ``out_dir`` and write ``index.html`` linking them.
+
+    Parameters
+    ----------
+    paths : program files
+    out_dir : directory, made when missing
+    options : ReportOptions
+    workers : int, default: 1
+        Worker processes; 1 runs in this process.
+    dask : str, optional
+        Address of a Dask scheduler (``tcp://host:8786``) to run the jobs on instead.
+    progress : bool, default: False
+        Show a progress bar on standard error.
+    force : bool, default: False
+        Overwrite existing reports; without it an existing file is an error.
+
+    Returns
+    -------
+    One row per program, in the order given: its key figures, or ``error``.
+
+    Raises
+    ------
+    FileExistsError
+        Naming the files that exist, when ``force`` is not given.
+    """
+    from tqdm import tqdm
+
+    from .html import index_page
+
+    out = Path(out_dir)
+    names = output_names(paths)
+    existing = [f for f in planned_outputs(names, options) if (out / f).exists()]
+    if existing and not force:
+        shown = ", ".join(existing[:5]) + (f" and {len(existing) - 5} more" if len(existing) > 5 else "")
+        raise FileExistsError(f"{out} already holds {shown}; use --force to overwrite")
+    out.mkdir(parents=True, exist_ok=True)
+    # absolute paths: a Dask worker may run in another directory (it must see the same file system)
+    jobs = [(os.path.abspath(p), os.path.abspath(out), n, options) for p, n in zip(paths, names)]
+    jobs.sort(key=lambda j: os.path.getsize(j[0]) if os.path.isfile(j[0]) else 0, reverse=True)
+    rows: dict[str, dict[str, Any]] = {}
+    with tqdm(total=len(jobs), unit="program", disable=not progress, desc="reports") as bar:
+        for job, row in _run(jobs, workers, dask):
+            rows[job[2]] = row
+            bar.update()
+    ordered = [rows[n] for n in names]
+    (out / "index.html").write_text(index_page(ordered), encoding="utf-8")
+    return ordered
+
+
+def _run(jobs: list[tuple], workers: int, dask: str | None):
+    """Yield (job, row) as jobs finish; a job whose worker died gets an error page here."""
+    if dask:
+        from distributed import Client
+        from distributed import as_completed as dask_completed
+
+        with Client(dask) as client:
+            futures = {client.submit(_job, job, pure=False): job for job in jobs}
+            for future in dask_completed(futures):
+                yield futures[future], _result(future, futures[future])
+    elif workers > 1 and len(jobs) > 1:
+        import multiprocessing
+
+        # spawn, not fork: the caller may hold threads (a Dask client, a notebook kernel)
+        with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=multiprocessing.get_context("spawn")) as pool:
+            futures = {pool.submit(_job, job): job for job in jobs}
+            for future in as_completed(futures):
+                yield futures[future], _result(future, futures[future])
+    else:
+        for job in jobs:
+            yield job, _job(job)
+
+
+def _result(future, job: tuple) -> dict[str, Any]:
+    try:
+        return future.result()
+    except Exception as exc:  # noqa: BLE001 -- a worker that died takes only its own program down
+        path, out, name, _ = job
+        row = _row(Path(path), name)
+        return _failed(row, Path(out) / row["html"], exc)
