@@ -68,3 +68,10 @@ def test_additive_part_counts_the_screws_volume_per_layer():
     assert part.deposition_length == pytest.approx(2 * 60 * INCH)
     # each perimeter: 4 sides of 2 s (20 in) and 1 s (10 in) -> 6 s; 110 then 120 rpm, 2 cm^3 per rev
     assert part.volume == pytest.approx((110 + 120) * 6 / 60 * 2.0 * 1000)
+
+
+def test_report_draws_the_screw_deposits():
+    from gcodekit.report.figures import toolpath_segments
+
+    seg = toolpath_segments(gcodekit.gcode_to_operation(WALL))
+    assert len(seg.start) == 8  # the two perimeters' eight sides, no travel

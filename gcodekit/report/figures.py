@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..analysis import depositing, features, layers
+from ..analysis import depositing, features, layers, screw_extruder
 from ..emulate.arcs import PLANES, sweep
 
 if TYPE_CHECKING:
@@ -69,7 +69,7 @@ def toolpath_segments(op: "Operation") -> Segments:
     xyz = np.column_stack([w["x"], w["y"], w["z"]]).astype(float)
     prev = np.vstack([xyz[:1], xyz[:-1]])
     moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
-    keep = depositing(w) if additive else moving
+    keep = depositing(w, screw_extruder(op)) if additive else moving
     idx = np.flatnonzero(keep)
     labels = None
     if additive:
@@ -276,10 +276,13 @@ def layer_times(rows: list[dict[str, Any]]) -> "Figure | None":
     """Planned time of each layer (bars)."""
     if not rows:
         return None
+    from matplotlib.ticker import MaxNLocator
+
     fig = _figure(2.8, left=0.08, right=0.98, bottom=0.16, top=0.9)
     ax = fig.add_subplot()
     ax.bar([r["layer"] for r in rows], [r["time_s"] for r in rows], width=1.0, color="#3b6ea8")
     ax.set_xlabel("layer")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("time, s")
     ax.set_title("Time per layer", fontsize=10)
     ax.grid(axis="y", alpha=0.3)
