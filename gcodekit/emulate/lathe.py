@@ -686,7 +686,7 @@ def run_lathe_cycle(block: CycleBlock) -> tuple[complex, list[Move]]:
     x = here.imag + p["X"] * k if block.incremental and "X" in p else p["X"] * k if "X" in p else here.imag
     z = here.real + p["Z"] * k if block.incremental and "Z" in p else p["Z"] * k if "Z" in p else here.real
     point = complex(z, x)
-    blocks, last = _read_profile(block, point)
+    blocks = _read_profile(block, point)
     segments = build_profile(point, blocks)
     if len(segments) <= 1:
         return point, []
@@ -694,20 +694,15 @@ def run_lathe_cycle(block: CycleBlock) -> tuple[complex, list[Move]]:
     if i <= 0:
         raise LatheCycleError("G7X error: I must be greater than zero.")
     d, e = p.get("D", 0.0) * k, p.get("E", 0.0) * k
-    first, final = segments[0].end - segments[0].start, segments[-1].end - segments[-1].start
     if cycle == 70:
         return point, finish(segments, point, d, e, p.get("P", 1.0))
-    if cycle == 71 and abs(final.real) > 0 and first.imag * (x - last.imag) < 0:
-        segments.append(_Line(last, complex(last.real, x)))
-    if cycle == 72 and abs(final.imag) > 0 and first.real * (z - last.real) < 0:
-        segments.append(_Line(last, complex(z, last.imag)))
     u = p.get("U", 0.0) * k / (2.0 if block.diameter else 1.0)
     return point, rough(segments, point, turn=cycle == 72, subcycle=sub, d=d, i=i, r=p.get("R", 0.5) * k,
                         u=u, w=p.get("W", 0.0) * k)
 
 
-def _read_profile(block: CycleBlock, start: complex) -> tuple[list[dict], complex]:
-    """Profile blocks (end points and centres in mm) and the profile's last point."""
+def _read_profile(block: CycleBlock, start: complex) -> list[dict]:
+    """Profile blocks: motion, end point and centre (mm), corner finish."""
     k, motion, here = block.scale, None, start
     halve = 2.0 if block.diameter else 1.0
     out = []
@@ -759,4 +754,4 @@ def _read_profile(block: CycleBlock, start: complex) -> tuple[list[dict], comple
         entry.update({c: words[c] * k for c in "AC" if c in words})
         out.append(entry)
         here = end
-    return out, here
+    return out
