@@ -19,6 +19,7 @@ from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, M
                            MOTION_THREAD, NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
 from ..parse.commands import Kind
 from .cycles import CYCLES, polar_target, run_cycle
+from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .splines import SPLINE_NAMES, SplineBlocks
 from .state import AXES, MachineState
 from .tooltable import Tool
@@ -67,6 +68,7 @@ class ModalHandler:
         self.machine = machine
         self.special_ids = np.array(sorted(NAME_ID[n] for n in SPECIAL_NAMES), np.uint8)
         self._last_dwell = 0.0  # dwell at the end of a canned cycle's last move
+        self._last_centre = (np.nan, np.nan, np.nan)  # arc centre of a lathe cycle's last move
         self._tool_change_line = -1  # source line of the last M6 (see tool length offsets)
         self.splines = SplineBlocks(machine.config.spline_tolerance)
         self.cycle_mode_open = False  # the last chunk ended in a canned-cycle mode
@@ -95,7 +97,9 @@ class ModalHandler:
                                                                 name.startswith("work_offset_")):
             self.machine.diagnostics.report(line, 1, "the program zero may not change while polar coordinates (G16) "
                                             "are on", kind="machine")
-        if moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
+        if name in LATHE_CYCLES:
+            motion, extra = self._lathe_cycle(name, params, t.command(row).comment, line)
+        elif moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
             if not (int(t.motion[row - 1]) == MOTION_CYCLE if row else self.cycle_mode_open):
                 s.cycle.initial = None  # the cycle mode begins here
             motion, extra = self._cycle(name, params, line)
@@ -219,6 +223,39 @@ class ModalHandler:
         s.position = steps[-1].point.copy()
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
+
+    def _lathe_cycle(self, name: str, params: dict, comment: str | None, line: int) -> tuple[int, list[Waypoint]]:
+        """G70-G72: the moves of a lathe cycle become waypoints (see :mod:`.lathe`)."""
+        s = self.state
+        program = s.program_position()
+        block = CycleBlock(name, params, profile_of(comment), complex(program[2], program[0]), s.units,
+                           s.incremental, s.arc_incremental, s.diameter, s.plane)
+        try:
+            point, moves = run_lathe_cycle(block)
+        except LatheCycleError as exc:
+            self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
+            return MOTION_NONE, []
+        offset = s.offset
+        here = program.copy()
+        steps = []
+        kinds = {"rapid": MOTION_RAPID, "feed": MOTION_LINEAR}
+        for move in [Move("rapid", point)] + moves:
+            end = program.copy()
+            end[[0, 2]] = move.end.imag, move.end.real
+            values = dict(zip(AXES.lower(), end + offset))
+            if move.kind == "arc":
+                if abs(end[0] - here[0]) < 1e-4 and abs(end[2] - here[2]) < 1e-4:
+                    continue  # rs274 skips an arc that ends where it starts
+                values.update(motion=MOTION_CCW if move.ccw else MOTION_CW, cx=move.centre.imag + offset[0],
+                              cy=np.nan, cz=move.centre.real + offset[2])
+            else:
+                values["motion"] = kinds[move.kind]
+            steps.append(Waypoint(values))
+            here = end
+        last = steps[-1].values
+        s.position = np.array([last[k] for k in AXES.lower()])
+        self._last_centre = tuple(last.get(k, np.nan) for k in ("cx", "cy", "cz"))
+        return int(last["motion"]), steps[:-1]
 
     def _thread(self, params: dict, line: int) -> float | None:
         """G33: a straight move at K units per spindle revolution; returns its feed (mm/min), None if refused."""
@@ -436,7 +473,9 @@ class ModalHandler:
         rate = self._rate(int(w.values.get("motion", MOTION_RAPID)))
         dwell = w.values.pop("dwell", 0.0)
         w.values.update(distance=distance, time=(distance / (rate / 60.0) if distance and rate > 0 else 0.0) + dwell,
-                        de=0.0, cx=np.nan, cy=np.nan, cz=np.nan)
+                        de=0.0)
+        for k in ("cx", "cy", "cz"):
+            w.values.setdefault(k, np.nan)
 
     def _rate(self, motion: int) -> float:
         """Feed of a move made by a special command, mm/min."""
@@ -457,6 +496,7 @@ class ModalHandler:
         out["de"][row] = de
         out["feed"][row] = rate if feed is not None else s.feed
         out["motion"][row] = motion
-        out["cx"][row] = out["cy"][row] = out["cz"][row] = np.nan
+        out["cx"][row], out["cy"][row], out["cz"][row] = self._last_centre
+        self._last_centre = (np.nan, np.nan, np.nan)
         out["spindle"][row] = s.speed * s.spindle
         self.machine.fill_state(row, out)

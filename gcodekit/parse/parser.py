@@ -24,7 +24,7 @@ from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
-from .table import (CYCLE_NAMES, MOTION_CUBIC, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
+from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CUBIC, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
                     MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable)
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
@@ -63,6 +63,7 @@ class GcodeParser:
         self._name_cache: dict[int, int] = {}
         self._unknown_reported: set[str] = set()
         self._cycle_ids = np.array([NAME_ID[n] for n in CYCLE_NAMES], np.uint8)
+        self._lathe_ids = np.array([NAME_ID[n] for n in LATHE_CYCLE_NAMES], np.uint8)
 
     # -- public ---------------------------------------------------------------
 
@@ -269,6 +270,10 @@ class GcodeParser:
             sets[name == NAME_ID[mname]] = mode
         sets[(name == NAME_ID["cancel_cycle"]) | (name == NAME_ID["nurbs_end"])] = MOTION_NONE
         sets[np.isin(name, self._cycle_ids)] = MOTION_CYCLE
+        # A lathe cycle (G70-G72) is no motion mode: rs274 leaves the mode of its
+        # last move in force, a feed (G1) but after a G70 ending in an arc.
+        lathe = np.isin(name, self._lathe_ids)
+        sets[lathe] = MOTION_LINEAR
         g53 = name == NAME_ID["machine_coordinates"]
         for i in np.flatnonzero(g53 & (letter != 0)):
             part = t.get("parts_by_row", {}).get(int(i))
@@ -277,6 +282,7 @@ class GcodeParser:
         motion = _forward_fill_modes(sets, self.motion)
         if n:
             self.motion = int(motion[-1])
+        motion[lathe] = MOTION_CYCLE
 
         def has(letters: str) -> np.ndarray:
             out = np.zeros(n, bool)
@@ -290,7 +296,7 @@ class GcodeParser:
         has_axes |= arc & has("IJKR")  # "G2 I5" is a full circle from where the tool is
         is_motion_name = np.isin(name, [NAME_ID[m] for m in _MOTION_MODES]) | np.isin(name, self._cycle_ids)
         implicit = (letter == 0) & has_axes if self._modal_motion else np.zeros(n, bool)
-        moving = (is_motion_name | implicit) & (has_axes | has_e)
+        moving = (is_motion_name | implicit) & (has_axes | has_e) | lathe
 
         kind = np.full(n, Kind.CONFIG, np.uint8)
         kind[letter == _G] = Kind.G

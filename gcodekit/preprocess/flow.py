@@ -77,6 +77,11 @@ _LABEL_NUMBER = re.compile(r"[0-9]+")
 _WORD = re.compile(r"([a-z])([-+]?[0-9.]*)")
 # Cheap test for a line that may hold M2, M30, M98 or M99.
 _MAYBE_FLOW_M = re.compile(r"[mM][ \t0]*(?:2|3[ \t]*0|9[ \t]*[89])")
+# Cheap test for a line that may hold a lathe cycle G70-G72
+_MAYBE_LATHE_CYCLE = re.compile(r"[gG][ \t0]*7[ \t]*[012]")
+_LATHE_CYCLES = frozenset((70.0, 71.0, 71.1, 71.2, 72.0, 72.1, 72.2))
+# The comment a lathe cycle's line gets: its profile (see gcodekit.emulate.lathe)
+PROFILE_TAG = "g7x profile:"
 # LinuxCNC subroutine file names: lower-case letters, digits, '-' and '_'.
 _FILE_NAME = re.compile(r"[a-z0-9_-]+")
 _CONDITIONS = ("if", "elseif", "while", "repeat")
@@ -459,6 +464,9 @@ class _Run:
         text = line.text
         if not text.strip(" \t" + self.separators):
             return
+        if _MAYBE_LATHE_CYCLE.search(text):
+            line = self._with_profile(line)
+            text = line.text
         flow = _MAYBE_FLOW_M.search(text) and self._flow_m(text)
         if not flow:
             yield line
@@ -476,6 +484,58 @@ class _Run:
             self._m98(line, p, count)
         else:
             self._m99(line)
+
+    def _with_profile(self, line: SourceLine) -> SourceLine:
+        """A lathe cycle (G70-G72) with the blocks of its Q subroutine attached as a comment.
+
+        rs274 reads the subroutine when the cycle runs, without moving: its
+        control flow and parameters run as in a call, ``#<_x>`` and ``#<_z>``
+        give the profile's point so far (the cycle's X/Z at first).
+        """
+        words = self._code_words(line.text)
+        if not any(letter == "g" and value in _LATHE_CYCLES for letter, value in words) or "q" not in dict(words):
+            return line
+        given = dict(words)
+        label = format_number(float(math.floor(given["q"] + 0.5)))
+        target = self._find(label, self.subs, line)
+        if target is None:
+            return line
+        point = {"_x": given.get("x", math.nan), "_z": given.get("z", math.nan)}
+        blocks = []
+        depth = len(self.frames)
+        self._enter(line, target, [], fanuc=False)
+        with self.store.overlay(lambda key: point.get(key) if isinstance(key, str) else None):
+            while len(self.frames) > depth:
+                items = self.code.items
+                if self.pc >= len(items):
+                    self._return()
+                    continue
+                st = items[self.pc]
+                if isinstance(st, OWord):
+                    self._oword(st)
+                    continue
+                self.pc += 1
+                with self._as_file(st.file):
+                    text = self.stage.parameters.substitute(st, self.diagnostics).text
+                code = dict(self._code_words(text))
+                for axis, key, letter in (("x", "_x", "u"), ("z", "_z", "w")):
+                    if axis in code:
+                        point[key] = code[axis]
+                    elif letter in code:
+                        point[key] += code[letter]
+                code_text = " ".join(text[a:b] for a, b in self.stage.parameters.code_ranges(text)).strip()
+                if code_text:
+                    blocks.append(code_text.replace(";", " ").replace("(", " ").replace(")", " "))
+        return line.__class__(f"{line.text} ({PROFILE_TAG} {'; '.join(blocks)})", line.line, line.file)
+
+    def _code_words(self, text: str) -> list[tuple[str, float]]:
+        """(letter, value) of the plain-number words of a line, comments left out."""
+        out = []
+        for start, end in self.stage.parameters.code_ranges(text):
+            for letter, number in _WORD.findall(compact(text, start, end).chars):
+                with contextlib.suppress(ValueError):
+                    out.append((letter, float(number)))
+        return out
 
     def _flow_m(self, text: str):
         """``(M code, spans of M98/M99/P/L, P, L)`` of a line, or None."""

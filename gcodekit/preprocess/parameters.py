@@ -9,6 +9,7 @@ removes parameter assignments, so later stages see plain words:
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import operator
 import re
@@ -163,6 +164,22 @@ class ParameterStore:
     def read_only(self, key: int | str) -> bool:
         """Whether ``key`` is a system parameter (which :meth:`set` refuses)."""
         return self._system is not None and self._system(_normalize(key)) is not None
+
+    @contextlib.contextmanager
+    def overlay(self, system: SystemParameters):
+        """Read-only parameters given by ``system`` first while the block lasts (a lathe
+        cycle reading its profile sees the profile's point as ``#<_x>``)."""
+        saved = self._system
+
+        def combined(key: int | str) -> float | None:
+            value = system(key)
+            return value if value is not None or saved is None else saved(key)
+
+        self._system = combined
+        try:
+            yield
+        finally:
+            self._system = saved
 
     def enter_call(self, args: Sequence[float] | None = None) -> None:
         """Open the scope of a subroutine call, as LinuxCNC ``execute_call``.

@@ -9,7 +9,7 @@ A program qualifies when ``RESULTS.tsv`` marks it ``ok``, it has motions, all
 of them matched to a source line (``line_match`` ok, ``nurbs`` for splines,
 or ``order`` for moves rs274 emitted late), no rotary-axis work or G92 offset is active (the CSV
 only carries X/Y/Z offsets), its text (comments stripped) uses no feature
-gcodekit does not emulate yet (:data:`EXCLUDED_G`: lathe cycles, G33.1,
+gcodekit does not emulate yet (:data:`EXCLUDED_G`: G33.1,
 G76; I/O M-codes, user or unknown
 codes, system parameters), and it is not a :data:`KNOWN_GAPS` program.
 
@@ -52,6 +52,7 @@ ANGLED = re.compile(r"<[^>]*>")
 LETTER_RUN = re.compile(r"[A-Z]{2,}")  # functions, operators and O-word keywords
 CODE = re.compile(r"(?<![A-Z])([GM])(\d+(?:\.\d+)?)")
 COMPUTED_CODE = re.compile(r"(?<![A-Z])[GM][\[#]")
+LATHE_CYCLE = re.compile(r"(?<![A-Z])G0*7[012](?:\.[12])?(?![0-9.])")
 SYSTEM_NUMBERED = re.compile(r"#5\d{3}(?!\d)")
 
 #: Predefined (read-only) named parameters of LinuxCNC 2.9.
@@ -69,6 +70,8 @@ _value _value_returned _task _call_level _remap_level
 #: Programs gcodekit knows it does not reproduce yet, and why.
 KNOWN_GAPS = {
     "nc_files/x-trim.ngc": "calls o<touchoff> from the plasma sample configuration, which probes (G38.2)",
+    "nc_files/lathe_g70_71_demo.ngc": "its G70 runs under G42.1: XZ-plane compensation of the finishing pass differs "
+                                      "(the G71.1/G71.2 roughing, motions 1-191, matches)",
     "nc_files/lathecomp.ngc": "XZ-plane compensation of a lathe program: corner rule and feed differ (not modelled)",
 }
 
@@ -76,10 +79,9 @@ KNOWN_GAPS = {
 EXCLUDED_G = {
     "76": "threading cycle not emulated yet",
     "33.1": "rigid tapping",
-    **dict.fromkeys(("70", "71", "71.1", "71.2", "72", "72.1", "72.2"), "lathe cycle"),
 }
 ALLOWED_G = frozenset("""
-0 1 2 3 4 5 5.1 5.2 5.3 7 8 10 17 33 17.1 38.2 38.3 38.4 38.5 41.1 42.1 73 74 81 82 83 84 85 86 87 88 89 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 41 42 43 43.1 43.2 49 52 53 54 55 56 57 58
+0 1 2 3 4 5 5.1 5.2 5.3 7 8 10 17 33 70 71 71.1 71.2 72 72.1 72.2 17.1 38.2 38.3 38.4 38.5 41.1 42.1 73 74 81 82 83 84 85 86 87 88 89 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 41 42 43 43.1 43.2 49 52 53 54 55 56 57 58
 59 59.1 59.2 59.3 61 61.1 64 80 90 90.1 91 91.1 92 92.1 92.2 92.3 93 94 95 96 97
 98 99
 """.split())
@@ -111,9 +113,11 @@ def scan_text(text: str) -> tuple[list[str], list[str]]:
     reasons: dict[str, None] = {}
     body = "\n".join(COMMENT.sub("", line) for line in text.upper().splitlines())
     body = re.sub(r"[ \t\r]", "", body)
+    # gcodekit gives #<_x>/#<_z> only while a lathe cycle reads its profile
+    profile_point = {"_x", "_z"} if LATHE_CYCLE.search(body) else set()
     for name in NAMED.findall(body):
         key = name.lower()
-        if key in SYSTEM_NAMED or key.startswith(("_ini[", "_hal[")):
+        if (key in SYSTEM_NAMED and key not in profile_point) or key.startswith(("_ini[", "_hal[")):
             reasons[f"system parameter #<{key}>"] = None
     body = ANGLED.sub("<>", body)
     body = LETTER_RUN.sub(" ", body)

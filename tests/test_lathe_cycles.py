@@ -1,0 +1,80 @@
+"""Lathe cycles G70-G72 (gcodekit.emulate.lathe) on small profiles worked out by hand.
+
+Reference: LinuxCNC 2.9.0~pre1 rs274 (run_rs274.sh); the corpus programs are
+golden cases in tests/golden/linuxcnc.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import gcodekit
+
+# A straight face from the cycle point's height down to X2 Z0, a taper to X4 Z-5, a step to X5.
+PROFILE = """G18 G21 F100
+O100 SUB
+G1 X2 Z0
+G1 X4 Z-5
+G1 X5
+O100 ENDSUB
+G0 X6 Z1
+{cycle}
+M2
+"""
+
+
+def moves(cycle: str) -> list[tuple[str, float, float]]:
+    op = gcodekit.gcode_to_operation(PROFILE.format(cycle=cycle), machine="linuxcnc", plan=False)
+    assert not [d for d in op.diagnostics if d.severity == "error"]
+    m = op.motions()
+    return [(r.motion, round(r.x, 4), round(r.z, 4)) for r in m.itertuples()][1:]  # after the G0 to X6 Z1
+
+
+def test_rough_turning_passes() -> None:
+    """G71 I0.5 R0.3 D0.2: passes every 0.5 in X, each ended 0.2 off the profile and left at 45 degrees by R."""
+    got = moves("G71 Q100 X6 Z1 D0.2 I0.5 R0.3")
+    # the cycle point, the approach and the first pass: X6 meets the step (Z-5) moved 0.2 towards Z+
+    assert got[:7] == [("rapid", 6.0, 1.0)] * 3 + [("feed", 6.0, -4.8), ("rapid", 6.3, -4.5),
+                                                   ("rapid", 6.3, 0.7), ("rapid", 6.0, 1.0)]
+    # the pass at X4 ends on the taper moved 0.2 along its normal (2, 5)/sqrt(29) in (Z, X)
+    n = math.sqrt(29.0)
+    x_on_taper = 4.0 - 1.0 / n
+    z_end = -(x_on_taper - 2.0) * 2.5 + 0.4 / n
+    passes = [m for m in got if m[0] == "feed" and m[1] == 4.0]
+    assert passes and passes[0][2] == pytest.approx(z_end, abs=1e-4) == -4.4615
+
+
+def test_finishing_pass_follows_the_profile() -> None:
+    """G70 D0 P1: rapid to the cycle point and along the profile's first block, then feed along the rest."""
+    got = moves("G70 Q100 X6 Z1")
+    assert got == [("rapid", 6.0, 1.0), ("rapid", 6.0, 1.0), ("rapid", 2.0, 0.0),
+                   ("feed", 4.0, -5.0), ("feed", 5.0, -5.0)]
+
+
+def test_profile_reads_its_own_point() -> None:
+    """Inside the profile #<_x> and #<_z> are the profile's point so far (rs274 moves nothing while reading)."""
+    program = PROFILE.replace("G1 X2 Z0", "G1 X[#<_x> - 4] Z[#<_z> - 1]").format(cycle="G70 Q100 X6 Z1")
+    op = gcodekit.gcode_to_operation(program, machine="linuxcnc", plan=False)
+    m = op.motions()
+    assert np.allclose(m[["x", "z"]].to_numpy()[3], [2.0, 0.0])
+
+
+@pytest.mark.parametrize("cycle, message", [
+    ("G71 X6 Z1 D0.2", "G7x.x  requires a Q word"),
+    ("G71 Q100 X6 Z1 D0.2 I0", "G7X error: I must be greater than zero."),
+])
+def test_errors_as_rs274(cycle: str, message: str) -> None:
+    """rs274's messages; it names the cycle's line (for I0 it names the profile's endsub, we the cycle)."""
+    op = gcodekit.gcode_to_operation(PROFILE.format(cycle=cycle), machine="linuxcnc", plan=False)
+    errors = [d for d in op.diagnostics if d.severity == "error"]
+    assert errors[0].message == message and errors[0].line == 8
+
+
+def test_plane_must_be_xz() -> None:
+    program = PROFILE.replace("G18", "G17").format(cycle="G71 Q100 X6 Z1 D0.2")
+    op = gcodekit.gcode_to_operation(program, machine="linuxcnc", plan=False)
+    errors = [d for d in op.diagnostics if d.severity == "error"]
+    assert errors[0].message == "G71.0 can only be used in XZ plane (G18)" and errors[0].line == 8
