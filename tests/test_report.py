@@ -221,6 +221,21 @@ def test_pdf_pages_are_not_blank_and_hold_the_plots(tmp_path):
     assert sum(c > 0.005 for c in colourful) >= 2
 
 
+def test_pages_printed_one_after_another_each_show_their_own_text(tmp_path):
+    _need("chromium", "chromium")
+    pdftotext = _need("pdftotext", "poppler-utils")
+    from gcodekit.report.pdf import html_to_pdf
+
+    for k in (1, 2):
+        (tmp_path / f"p{k}.html").write_text(f"<html><body><h1>page {k}</h1></body></html>")
+    with pytest.raises(RuntimeError, match="could not open"):
+        html_to_pdf(tmp_path / "missing.html", tmp_path / "missing.pdf")
+    for k in (1, 2, 1):  # the browser's one tab, after an error and back to a page it printed
+        html_to_pdf(tmp_path / f"p{k}.html", tmp_path / "out.pdf")
+        text = subprocess.run([pdftotext, str(tmp_path / "out.pdf"), "-"], capture_output=True, text=True).stdout
+        assert text.strip() == f"page {k}"
+
+
 def chromium_console(page: Path) -> tuple[list[str], str]:
     """Console messages Chromium logs while loading ``page``, and the DOM it ends with."""
     from gcodekit.report.pdf import chromium_command

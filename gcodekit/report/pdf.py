@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import atexit
 import base64
+import contextlib
 import fcntl
 import json
 import os
@@ -79,6 +80,8 @@ class Browser:
         self._buffer = b""
         self._next_id = 0
         self._events: list[dict[str, Any]] = []
+        self._target: str | None = None
+        self._session: str | None = None  # of the tab pages are printed in, made by the first print
 
     def _read(self) -> dict[str, Any]:
         while b"\0" not in self._buffer:
@@ -114,19 +117,28 @@ class Browser:
             self._events.append(self._read())
 
     def print_pdf(self, url: str) -> bytes:
-        """The PDF of the page at ``url``: page size from its CSS, backgrounds printed, no header or footer."""
-        target = self.call("Target.createTarget", url="about:blank")["targetId"]
+        """The PDF of the page at ``url``: page size from its CSS, backgrounds printed, no header or footer.
+
+        Every page is printed in the same tab: a new tab per page started a
+        renderer each time, a third to a half of a print's CPU.
+        """
+        if self._session is None:
+            self._target = self.call("Target.createTarget", url="about:blank")["targetId"]
+            self._session = self.call("Target.attachToTarget", targetId=self._target, flatten=True)["sessionId"]
+            self.call("Page.enable", session=self._session)
         try:
-            session = self.call("Target.attachToTarget", targetId=target, flatten=True)["sessionId"]
-            self.call("Page.enable", session=session)
-            error = self.call("Page.navigate", session=session, url=url).get("errorText")
+            error = self.call("Page.navigate", session=self._session, url=url).get("errorText")
             if error:
                 raise RuntimeError(f"chromium could not open {url}: {error}")
-            self._wait("Page.loadEventFired", session)
-            data = self.call("Page.printToPDF", session=session, printBackground=True, preferCSSPageSize=True,
-                             displayHeaderFooter=False)["data"]
+            self._wait("Page.loadEventFired", self._session)
+            data = self.call("Page.printToPDF", session=self._session, printBackground=True,
+                             preferCSSPageSize=True, displayHeaderFooter=False)["data"]
+        except (OSError, RuntimeError):
+            self._session = None  # a fresh tab next time, not one left half-loaded
+            with contextlib.suppress(OSError, RuntimeError):
+                self.call("Target.closeTarget", targetId=self._target)
+            raise
         finally:
-            self.call("Target.closeTarget", targetId=target)
             self._events.clear()
         return base64.b64decode(data)
 
