@@ -143,6 +143,24 @@ def test_batch_on_two_processes_survives_a_failing_program(tmp_path, print_file)
     assert index.count('class="error"') >= 2
 
 
+def test_workers_are_forked_only_from_a_process_without_other_threads(tmp_path, print_file):
+    import threading
+
+    from gcodekit.report.batch import _start_method
+
+    done = threading.Event()
+    waiter = threading.Thread(target=done.wait)
+    waiter.start()
+    try:
+        assert _start_method().get_start_method() == "spawn"
+        rows = write_reports([print_file, print_file], tmp_path / "out", options=ReportOptions(pdf=False),
+                             workers=2, progress=True)
+    finally:
+        done.set()
+        waiter.join()
+    assert [r["error"] for r in rows] == [None, None] and rows[1]["html"] == "tiny.gcode-2.html"
+
+
 def test_batch_on_a_dask_cluster(tmp_path, print_file):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,

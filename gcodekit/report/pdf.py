@@ -65,12 +65,13 @@ class Browser:
     """A headless Chromium driven over its DevTools pipe, with its own throw-away profile."""
 
     def __init__(self) -> None:
-        self._profile = tempfile.TemporaryDirectory(prefix="gcodekit-chromium-")
+        # a plain directory, not a TemporaryDirectory, whose finalizer would remove it in a forked child too
+        self._profile = tempfile.mkdtemp(prefix="gcodekit-chromium-")
         to_chromium, self._send = os.pipe()
         self._receive, from_chromium = os.pipe()
         # above 9, so that putting them on 3 and 4 below cannot overwrite one with the other
         to_chromium, from_chromium = (_above_9(fd) for fd in (to_chromium, from_chromium))
-        cmd = chromium_command("--remote-debugging-pipe", "about:blank", profile=self._profile.name)
+        cmd = chromium_command("--remote-debugging-pipe", "about:blank", profile=self._profile)
         # bash (dash takes single-digit descriptors only) puts the pipe ends on 3 and 4, where Chromium reads
         self._proc = subprocess.Popen(["bash", "-c", f'exec "$0" "$@" 3<&{to_chromium} 4>&{from_chromium}', *cmd],
                                       pass_fds=(to_chromium, from_chromium), stdin=subprocess.DEVNULL,
@@ -155,7 +156,12 @@ class Browser:
         except subprocess.TimeoutExpired:
             self._proc.kill()
             self._proc.wait()
-        self._profile.cleanup()
+        shutil.rmtree(self._profile, ignore_errors=True)
+
+    def forget(self) -> None:
+        """Close this process's ends of the pipe only: in a forked child, Chromium is the parent's."""
+        for fd in (self._send, self._receive):
+            os.close(fd)
 
 
 def _above_9(fd: int) -> int:
@@ -175,7 +181,17 @@ def _close_browser() -> None:
         _browser = None
 
 
+def _forget_browser() -> None:
+    """In a forked child: the parent's browser is not the child's to use or quit."""
+    global _browser, _lock
+    if _browser is not None:
+        _browser.forget()
+        _browser = None
+    _lock = threading.Lock()
+
+
 atexit.register(_close_browser)
+os.register_at_fork(after_in_child=_forget_browser)
 
 
 def html_to_pdf(html: str | os.PathLike, pdf: str | os.PathLike) -> Path:
