@@ -47,10 +47,11 @@ def run_report(programs: list[Path], workers: int, repeat: int) -> float:
         with tempfile.TemporaryDirectory() as out:
             cmd = [sys.executable, "-m", "gcodekit.cli", "report", *map(str, programs), "-o", out,
                    "--workers", str(workers), "--no-progress"]
-            print(f"    (load average {os.getloadavg()[0]:.1f} before a run with {workers} worker(s))")
+            load = os.getloadavg()[0]
             start = time.perf_counter()
             done = subprocess.run(cmd, capture_output=True, text=True, env=ENV)
             elapsed = time.perf_counter() - start
+            print(f"    {workers} worker(s): {elapsed:6.2f} s (load average {load:.1f} before)")
             if done.returncode != 0:
                 sys.exit(f"gcodekit report failed:\n{done.stderr}")
             if len(list(Path(out).glob("*.pdf"))) != len(programs):
