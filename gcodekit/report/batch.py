@@ -230,8 +230,8 @@ def _running(jobs: list[tuple], workers: int, dask: str | None) -> Iterator[Iter
 def _start_method() -> "multiprocessing.context.BaseContext":
     """fork on Linux when this process runs no other thread, else spawn.
 
-    Forked workers start with gcodekit, NumPy and pandas already imported
-    (0.3 s and 0.3 CPU-s each less than spawn, on a batch of 10 s); forking a
+    Forked workers start with gcodekit and NumPy already imported (0.3 s
+    and 0.3 CPU-s each less than spawn, on a batch of 10 s); forking a
     process whose other threads (a Dask client, a notebook kernel) may hold a
     lock can hang the child, and macOS libraries do not survive a fork.
     """
