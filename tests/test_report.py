@@ -143,6 +143,24 @@ def test_batch_on_two_processes_survives_a_failing_program(tmp_path, print_file)
     assert index.count('class="error"') >= 2
 
 
+def test_workers_are_forked_only_from_a_process_without_other_threads(tmp_path, print_file):
+    import threading
+
+    from gcodekit.report.batch import _start_method
+
+    done = threading.Event()
+    waiter = threading.Thread(target=done.wait)
+    waiter.start()
+    try:
+        assert _start_method().get_start_method() == "spawn"
+        rows = write_reports([print_file, print_file], tmp_path / "out", options=ReportOptions(pdf=False),
+                             workers=2, progress=True)
+    finally:
+        done.set()
+        waiter.join()
+    assert [r["error"] for r in rows] == [None, None] and rows[1]["html"] == "tiny.gcode-2.html"
+
+
 def test_batch_on_a_dask_cluster(tmp_path, print_file):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
@@ -219,6 +237,21 @@ def test_pdf_pages_are_not_blank_and_hold_the_plots(tmp_path):
     assert min(inked) > 0.01, inked
     assert max(colourful) > 0.03, colourful  # the toolpath views and bar charts
     assert sum(c > 0.005 for c in colourful) >= 2
+
+
+def test_pages_printed_one_after_another_each_show_their_own_text(tmp_path):
+    _need("chromium", "chromium")
+    pdftotext = _need("pdftotext", "poppler-utils")
+    from gcodekit.report.pdf import html_to_pdf
+
+    for k in (1, 2):
+        (tmp_path / f"p{k}.html").write_text(f"<html><body><h1>page {k}</h1></body></html>")
+    with pytest.raises(RuntimeError, match="could not open"):
+        html_to_pdf(tmp_path / "missing.html", tmp_path / "missing.pdf")
+    for k in (1, 2, 1):  # the browser's one tab, after an error and back to a page it printed
+        html_to_pdf(tmp_path / f"p{k}.html", tmp_path / "out.pdf")
+        text = subprocess.run([pdftotext, str(tmp_path / "out.pdf"), "-"], capture_output=True, text=True).stdout
+        assert text.strip() == f"page {k}"
 
 
 def chromium_console(page: Path) -> tuple[list[str], str]:

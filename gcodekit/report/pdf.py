@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import atexit
 import base64
+import contextlib
 import fcntl
 import json
 import os
@@ -64,12 +65,13 @@ class Browser:
     """A headless Chromium driven over its DevTools pipe, with its own throw-away profile."""
 
     def __init__(self) -> None:
-        self._profile = tempfile.TemporaryDirectory(prefix="gcodekit-chromium-")
+        # a plain directory, not a TemporaryDirectory, whose finalizer would remove it in a forked child too
+        self._profile = tempfile.mkdtemp(prefix="gcodekit-chromium-")
         to_chromium, self._send = os.pipe()
         self._receive, from_chromium = os.pipe()
         # above 9, so that putting them on 3 and 4 below cannot overwrite one with the other
         to_chromium, from_chromium = (_above_9(fd) for fd in (to_chromium, from_chromium))
-        cmd = chromium_command("--remote-debugging-pipe", "about:blank", profile=self._profile.name)
+        cmd = chromium_command("--remote-debugging-pipe", "about:blank", profile=self._profile)
         # bash (dash takes single-digit descriptors only) puts the pipe ends on 3 and 4, where Chromium reads
         self._proc = subprocess.Popen(["bash", "-c", f'exec "$0" "$@" 3<&{to_chromium} 4>&{from_chromium}', *cmd],
                                       pass_fds=(to_chromium, from_chromium), stdin=subprocess.DEVNULL,
@@ -79,6 +81,8 @@ class Browser:
         self._buffer = b""
         self._next_id = 0
         self._events: list[dict[str, Any]] = []
+        self._target: str | None = None
+        self._session: str | None = None  # of the tab pages are printed in, made by the first print
 
     def _read(self) -> dict[str, Any]:
         while b"\0" not in self._buffer:
@@ -114,19 +118,28 @@ class Browser:
             self._events.append(self._read())
 
     def print_pdf(self, url: str) -> bytes:
-        """The PDF of the page at ``url``: page size from its CSS, backgrounds printed, no header or footer."""
-        target = self.call("Target.createTarget", url="about:blank")["targetId"]
+        """The PDF of the page at ``url``: page size from its CSS, backgrounds printed, no header or footer.
+
+        Every page is printed in the same tab: a new tab per page started a
+        renderer each time, a third to a half of a print's CPU.
+        """
+        if self._session is None:
+            self._target = self.call("Target.createTarget", url="about:blank")["targetId"]
+            self._session = self.call("Target.attachToTarget", targetId=self._target, flatten=True)["sessionId"]
+            self.call("Page.enable", session=self._session)
         try:
-            session = self.call("Target.attachToTarget", targetId=target, flatten=True)["sessionId"]
-            self.call("Page.enable", session=session)
-            error = self.call("Page.navigate", session=session, url=url).get("errorText")
+            error = self.call("Page.navigate", session=self._session, url=url).get("errorText")
             if error:
                 raise RuntimeError(f"chromium could not open {url}: {error}")
-            self._wait("Page.loadEventFired", session)
-            data = self.call("Page.printToPDF", session=session, printBackground=True, preferCSSPageSize=True,
-                             displayHeaderFooter=False)["data"]
+            self._wait("Page.loadEventFired", self._session)
+            data = self.call("Page.printToPDF", session=self._session, printBackground=True,
+                             preferCSSPageSize=True, displayHeaderFooter=False)["data"]
+        except (OSError, RuntimeError):
+            self._session = None  # a fresh tab next time, not one left half-loaded
+            with contextlib.suppress(OSError, RuntimeError):
+                self.call("Target.closeTarget", targetId=self._target)
+            raise
         finally:
-            self.call("Target.closeTarget", targetId=target)
             self._events.clear()
         return base64.b64decode(data)
 
@@ -143,7 +156,12 @@ class Browser:
         except subprocess.TimeoutExpired:
             self._proc.kill()
             self._proc.wait()
-        self._profile.cleanup()
+        shutil.rmtree(self._profile, ignore_errors=True)
+
+    def forget(self) -> None:
+        """Close this process's ends of the pipe only: in a forked child, Chromium is the parent's."""
+        for fd in (self._send, self._receive):
+            os.close(fd)
 
 
 def _above_9(fd: int) -> int:
@@ -163,7 +181,17 @@ def _close_browser() -> None:
         _browser = None
 
 
+def _forget_browser() -> None:
+    """In a forked child: the parent's browser is not the child's to use or quit."""
+    global _browser, _lock
+    if _browser is not None:
+        _browser.forget()
+        _browser = None
+    _lock = threading.Lock()
+
+
 atexit.register(_close_browser)
+os.register_at_fork(after_in_child=_forget_browser)
 
 
 def html_to_pdf(html: str | os.PathLike, pdf: str | os.PathLike) -> Path:
