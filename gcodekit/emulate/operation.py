@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import Diagnostics
 from ..parse.commands import Command, Kind
-from ..parse.table import MOTION_NAMES, CommandTable
+from ..parse.table import MOTION_NAMES, NAME_ID, CommandTable
 from ..syntax.flavor import code_label
 from .machine import FLOAT_COLUMNS, SMALL_COLUMNS
 from .state import MM_PER_INCH
@@ -406,33 +406,31 @@ class AdditiveOperation(Operation):
     def bead_areas(self) -> np.ndarray:
         """Programmed bead cross-section in force at each waypoint (mm^2).
 
-        The last ``bead_command`` call (CEAD's ``EXTRUDERSPEED2(w, h, ..)``)
-        before the waypoint gives width x height; NaN before the first
-        call, or when the machine names no such command.
+        The last ``set_bead`` command (CEAD's ``EXTRUDERSPEED2(w, h, ..)``)
+        at or before the waypoint gives width x height; NaN before the
+        first one.
 
         Examples
         --------
         >>> import gcodekit
-        >>> op = gcodekit.gcode_to_operation("EXTRUDERSPEED2(8,2,1400)\nG1 F600 X10 EM=1\nM30\n", "cead")
+        >>> op = gcodekit.gcode_to_operation("EXTRUDERSPEED2(8,2,1400)\\nG1 F600 X10 EM=1\\nM30\\n", "cead")
         >>> op.bead_areas().tolist()[-2:]
         [16.0, 16.0]
         """
+        from .modal import bead_area
+
         w = self.waypoints
         rows = np.asarray(w["command"]) if "command" in w else np.arange(len(w["x"]))
-        name = self.machine.bead_command.upper() if self.machine else ""
-        area_of_row = np.full(len(self.table), np.nan)
-        set_at = np.full(len(self.table), -1)
-        for row, (called, args) in sorted(self.table.named.items()):
-            if name and called.upper() == name:
-                values = args.strip("() ").split(",")
-                try:
-                    area_of_row[row] = float(values[0]) * float(values[1])
-                except (IndexError, ValueError):
-                    area_of_row[row] = np.nan  # a bead the emulator cannot read: unknown from here
-                set_at[row] = row
+        n = len(self.table)
+        calls = np.flatnonzero(np.asarray(self.table.name) == NAME_ID["set_bead"]) if n else np.zeros(0, int)
+        area_of_row = np.full(n, np.nan)
+        set_at = np.full(n, -1)
+        for row in calls.tolist():
+            area_of_row[row] = bead_area(self.table.named.get(row, ("", ""))[1])
+            set_at[row] = row
         np.maximum.accumulate(set_at, out=set_at)  # the last call at or before each row
         area = np.where(set_at >= 0, area_of_row[np.maximum(set_at, 0)], np.nan)
-        return area[rows] if area.size else np.full(len(rows), np.nan)
+        return area[rows] if n else np.full(len(rows), np.nan)
 
     def _process_fields(self, k: int) -> dict[str, Any]:
         fields = super()._process_fields(k)

@@ -114,12 +114,6 @@ class MachineConfig:
     screw_displacement : float
         cm^3 of material a screw extruder delivers per revolution; 0 leaves
         its deposited volume unknown (NaN).
-    bead_command : str
-        With ``extruder_type = "bead"``: the named command whose first two
-        arguments are the bead width and height in mm
-        (``EXTRUDERSPEED2(8,2,1400)``); a feed move with deposition on
-        lays width x height x length.  Before the first such command the
-        volume is unknown (NaN).
     """
 
     name: str
@@ -153,7 +147,6 @@ class MachineConfig:
     cycle_retract: str = "initial"
     table_axis: str = ""
     screw_displacement: float = 0.0
-    bead_command: str = ""
 
     def __hash__(self) -> int:
         return hash(self.name)

@@ -46,7 +46,7 @@ COMMANDS = frozenset(
     fan_on fan_off
     set_max_accel set_max_feed set_accel set_jerk set_junction_deviation wait_moves
     mesh_level motors_off message progress set_kinematic_position
-    weld_start laser_on laser_off deposition_switch
+    weld_start laser_on laser_off deposition_switch set_bead
     probe
     """.split()
 )
