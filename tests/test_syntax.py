@@ -91,7 +91,7 @@ def _write(tmp_path, text, name="bad"):
         ('name = "bad"\nstatement_separators = [";"]\n', r"statement_separators: ';' is also in line_comments"),
         ('name = "bad"\nlayer_comments = ["(unclosed"]\n', r"layer_comments: invalid regular expression"),
         ('name = "bad"\nfeature_comment = "^TYPE:"\n', r"feature_comment: .* needs a \(group\)"),
-        ('name = "bad"\n[codes]\nPRINT_START = "program_stop"\n', r"PRINT_START: extended command names need extended_commands"),
+        ('name = "bad"\n[codes]\nPRINT_START = "program_stop"\n', r"PRINT_START: named commands need extended_commands"),
         ('name = "bad"\nline_number_letter = ""\n[words]\nN = "line_number"\n', r"\[words\] N: maps to 'line_number'"),
         ('name = "bad"\ninherit = "marlinn"\n', r"inherit: unknown flavor 'marlinn' \(did you mean 'marlin'\?\)"),
         ('name = "bad"\n[detect]\npriority = "high"\n', r"\[detect\] priority: expected an integer"),

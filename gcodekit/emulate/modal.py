@@ -36,7 +36,7 @@ SPECIAL_NAMES = frozenset(
     coolant_mist coolant_flood coolant_off program_end machine_coordinates
     firmware_retract firmware_unretract set_kinematic_position
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
-    coordinate_data local_offset retract_initial retract_r laser_on laser_off polar_on polar_off diameter_mode radius_mode""".split()
+    coordinate_data local_offset retract_initial retract_r laser_on laser_off deposition_switch set_bead polar_on polar_off diameter_mode radius_mode""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)} | SPLINE_NAMES
 
 _MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
@@ -52,6 +52,21 @@ _SIMPLE = {
     "polar_on": ("polar", True), "polar_off": ("polar", False),
     "diameter_mode": ("diameter", True), "radius_mode": ("diameter", False),
 }
+
+
+def bead_area(arguments: str) -> float:
+    """Width x height (mm^2) from a bead call's argument text ``"8,2,1400"``; NaN if unreadable.
+
+    Examples
+    --------
+    >>> bead_area("8.0000,2.0000,1400"), bead_area("0,0,1")
+    (16.0, 0.0)
+    """
+    values = arguments.strip("() ").split(",")
+    try:
+        return float(values[0]) * float(values[1])
+    except (IndexError, ValueError):
+        return float("nan")
 
 
 @dataclass
@@ -153,6 +168,12 @@ class ModalHandler:
             s.speed = params.get("S", s.speed)
         elif name in ("laser_on", "laser_off"):
             s.laser = int(name == "laser_on")
+        elif name == "deposition_switch":  # CEAD's "EM=1" / "EM=0": material on or off from here
+            s.laser = int(params.get("value", 1.0) != 0.0)
+        elif name == "set_bead":  # CEAD's EXTRUDERSPEED2(w, h, ..): a zero bead is the screw at 0 rpm
+            area = bead_area(t.named.get(row, ("", ""))[1])
+            if area == 0.0:
+                s.laser = 0
         elif name in ("coolant_mist", "coolant_flood", "coolant_off"):
             s.coolant = {"coolant_mist": s.coolant | 1, "coolant_flood": s.coolant | 2, "coolant_off": 0}[name]
         elif name == "program_end":

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import Diagnostics
 from ..parse.commands import Command, Kind
-from ..parse.table import MOTION_NAMES, CommandTable
+from ..parse.table import MOTION_NAMES, NAME_ID, CommandTable
 from ..syntax.flavor import code_label
 from .machine import FLOAT_COLUMNS, SMALL_COLUMNS
 from .state import MM_PER_INCH
@@ -383,9 +383,11 @@ class AdditiveOperation(Operation):
         """Material laid by each waypoint (mm^3).
 
         Filament machines: E pushed times the filament's cross-section.  Screw
-        extruders (BAAM, CEAD): rpm x minutes x the screw's displacement per
+        extruders (BAAM): rpm x minutes x the screw's displacement per
         revolution while the screw turns on a feed move; NaN when the machine
-        does not give its displacement.  Wire and powder (DED): unknown, NaN.
+        does not give its displacement.  Bead extruders (CEAD): the
+        programmed bead's width x height x the move's length while
+        deposition is on (``EM=1``).  Wire and powder (DED): unknown, NaN.
         """
         w = self.waypoints
         kind = self.machine.extruder_type if self.machine else "filament"
@@ -396,7 +398,39 @@ class AdditiveOperation(Operation):
             per_rev = self.machine.screw_displacement * 1000.0 or np.nan  # cm^3 -> mm^3
             minutes = np.nan_to_num(np.asarray(w["time"], float)) / 60.0
             return np.where(turning, np.asarray(w["spindle"], float) * minutes * per_rev, 0.0)
-        return np.where(np.asarray(w.get("laser", np.zeros(len(w["x"])))) == 1, np.nan, 0.0)
+        on = (np.asarray(w.get("laser", np.zeros(len(w["x"])))) == 1) & (np.asarray(w["motion"]) >= 2)
+        if kind == "bead":
+            return np.where(on, self.bead_areas() * np.asarray(w["distance"], float), 0.0)
+        return np.where(on, np.nan, 0.0)
+
+    def bead_areas(self) -> np.ndarray:
+        """Programmed bead cross-section in force at each waypoint (mm^2).
+
+        The last ``set_bead`` command (CEAD's ``EXTRUDERSPEED2(w, h, ..)``)
+        at or before the waypoint gives width x height; NaN before the
+        first one.
+
+        Examples
+        --------
+        >>> import gcodekit
+        >>> op = gcodekit.gcode_to_operation("EXTRUDERSPEED2(8,2,1400)\\nG1 F600 X10 EM=1\\nM30\\n", "cead")
+        >>> op.bead_areas().tolist()[-2:]
+        [16.0, 16.0]
+        """
+        from .modal import bead_area
+
+        w = self.waypoints
+        rows = np.asarray(w["command"]) if "command" in w else np.arange(len(w["x"]))
+        n = len(self.table)
+        calls = np.flatnonzero(np.asarray(self.table.name) == NAME_ID["set_bead"]) if n else np.zeros(0, int)
+        area_of_row = np.full(n, np.nan)
+        set_at = np.full(n, -1)
+        for row in calls.tolist():
+            area_of_row[row] = bead_area(self.table.named.get(row, ("", ""))[1])
+            set_at[row] = row
+        np.maximum.accumulate(set_at, out=set_at)  # the last call at or before each row
+        area = np.where(set_at >= 0, area_of_row[np.maximum(set_at, 0)], np.nan)
+        return area[rows] if n else np.full(len(rows), np.nan)
 
     def _process_fields(self, k: int) -> dict[str, Any]:
         fields = super()._process_fields(k)

@@ -32,7 +32,7 @@ _CHOICES = {
     "tool_table_units": ("mm", "inch"),
     "cycle_retract": ("initial", "r"),
     "table_axis": ("", "W"),
-    "extruder_type": ("filament", "screw", "wire", "powder"),
+    "extruder_type": ("filament", "screw", "bead", "wire", "powder"),
 }
 
 
@@ -77,10 +77,12 @@ class MachineConfig:
         mm; turns extruded length into volume.
     filament_density : float
         g/cm^3; turns volume into mass.
-    extruder_type : {"filament", "screw", "wire", "powder"}
+    extruder_type : {"filament", "screw", "bead", "wire", "powder"}
         How material reaches the bead: filament drive (FFF), pellet screw
-        (LFAM: BAAM, CEAD; it turns at the spindle speed S while the
-        spindle is on, M3), wire or powder feed (DED).
+        (LFAM: BAAM; it turns at the spindle speed S while the spindle is
+        on, M3), a screw the controller slaves to the path so a programmed
+        bead follows it (``bead``: CEAD's ``EXTRUDERSPEED2(w, h, ..)`` and
+        ``EM=1``), wire or powder feed (DED).
     work_offsets : mapping of str to list of float
         Initial G54-G59.3 offsets in mm, e.g. ``G55 = [100, 0, 0]``.
     retract_length, unretract_extra_length : float

@@ -213,6 +213,9 @@ class GcodeParser:
                 self.diagnostics.report(line, 1, message, severity="error" if self._modal else "warning")
             if extra is not None and extra.named is not None:
                 parts = [Part("@", named=extra.named[:2])] + parts
+            if extra is not None and extra.assignments:  # Sinumerik "EM=1": set before the block moves
+                parts = [Part("@", params={"value": value}, named=(name, f"{value:g}"))
+                         for name, value, _ in extra.assignments] + parts
             if extra is not None and extra.code_value is not None and parts:
                 parts[0].params["value"] = extra.code_value
             if not parts:

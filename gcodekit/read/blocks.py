@@ -159,5 +159,5 @@ class Blocks:
             comment_offsets=offsets,
             comment_data=b"".join(encoded),
             extras={i: b for i, b in enumerate(raw)
-                    if b.flags or b.named or b.text or b.code_value is not None or b.deleted},
+                    if b.flags or b.named or b.text or b.code_value is not None or b.deleted or b.assignments},
         )

@@ -8,6 +8,7 @@ two must agree; ``tests/test_read.py`` checks that they do.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from ..errors import Diagnostics
@@ -18,6 +19,11 @@ _DIGITS = "0123456789"
 _SPACE = " \t\r\f\v"
 #: No machine takes coordinates this large; longer numbers are typos or garbage.
 _LARGEST = 1e15
+#: Sinumerik 840D value assignment: an address or variable, an optional
+#: ``[index]``, ``=`` and a number (``EM=1``, ``R1=2.5``, ``H[10]=1``).
+_ASSIGNMENT = re.compile(r"([A-Za-z_][A-Za-z0-9_]*(?:\[\s*\d+\s*\])?)\s*=\s*([+-]?(?:\d+\.?\d*|\.\d+))")
+#: Sinumerik 840D call of a cycle or subprogram with arguments: ``CYCLE832(2,_finish,1)``.
+_CALL = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)\s*\(")
 
 
 @dataclass(slots=True)
@@ -31,10 +37,11 @@ class RawBlock:
     named: tuple[str, str, int] | None = None
     text: str | None = None
     code_value: float | None = None
+    assignments: list[tuple[str, float, int]] = field(default_factory=list)
     deleted: bool = False
 
     def is_empty(self) -> bool:
-        return not (self.words or self.comments or self.flags or self.named or self.text)
+        return not (self.words or self.comments or self.flags or self.named or self.text or self.assignments)
 
     def add_text(self, text: str) -> None:
         """Keep a string argument (``M117 Hello``, ``P"MK3S"``) with the block."""
@@ -91,6 +98,8 @@ class LineTokenizer:
         if self._named_ok and self._starts_named(text, i):
             self._read_named(text, i, block)
             return blocks
+        if fl.assignments and (call := _CALL.match(text, i)):
+            i = self._read_call(text, i, call, block)
         while i < n:
             c = text[i]
             if c in _SPACE:
@@ -107,6 +116,12 @@ class LineTokenizer:
             elif c == "*" and fl.checksum:
                 self._check_sum(text, i, line)
                 i = self._skip_checksum(text, i)
+            elif fl.assignments and (c.isalpha() or c == "_") and (found := self._assignment(text, i)):
+                name, value, col, i = found
+                if name in fl.words:  # "X=10" is "X10"
+                    block.words.append((name, value, col))
+                else:
+                    block.assignments.append((name, value, col))
             elif (c.isalpha() and c.isascii() and (c.isupper() or not fl.case_sensitive)) or (
                     c in "@^" and fl.polar_words):
                 i = self._word(text, i, block)
@@ -222,6 +237,30 @@ class LineTokenizer:
                 block.comments.append((rest[cut + 1 :].strip(), j + cut + 1))
             return n
         return j
+
+    def _assignment(self, text: str, i: int) -> tuple[str, float, int, int] | None:
+        """A Sinumerik ``NAME=value`` at ``text[i]``: (name, value, column, end), or None.
+
+        A single letter the flavor maps to a parameter stays a word
+        (Sinumerik also accepts ``X=10`` for ``X10``); every other name is an
+        assignment to an address with an extension (``H[10]``, ``R1``) or to
+        a variable or machine data (``EM``), kept for the parse stage.
+        """
+        m = _ASSIGNMENT.match(text, i)
+        if m is None:
+            return None
+        name = re.sub(r"\s+", "", m.group(1)).upper()
+        value = float(m.group(2))
+        return name, value, i + 1, m.end()
+
+    def _read_call(self, text: str, i: int, call: "re.Match[str]", block: RawBlock) -> int:
+        """A Sinumerik cycle or subprogram call ``NAME(arguments)``, kept as a named command."""
+        close = text.find(")", call.end())
+        if close < 0:
+            self.diagnostics.report(block.line, call.end(), f"call {call.group(1)!r} is not closed with ')'", text)
+            close = len(text) - 1
+        block.named = (call.group(1).upper(), text[call.end():close].strip(), i + 1)
+        return close + 1
 
     def _starts_named(self, text: str, i: int) -> bool:
         """A name of two or more letters (``SET_VELOCITY_LIMIT``, ``Pocket``)."""

@@ -47,7 +47,7 @@ COMMANDS = frozenset(
     fan_on fan_off
     set_max_accel set_max_feed set_accel set_jerk set_junction_deviation wait_moves
     mesh_level motors_off message progress set_kinematic_position
-    weld_start laser_on laser_off
+    weld_start laser_on laser_off deposition_switch set_bead
     probe
     """.split()
 )
@@ -139,6 +139,13 @@ class Flavor:
     code_assignments : bool
         A code may carry a value after ``=`` (Beckhoff ``M60=1``); the value
         becomes the command's ``value`` parameter.
+    assignments : bool
+        Siemens Sinumerik 840D value assignments and calls: ``NAME=value``
+        in a block (``EM=1``, ``R1=2.5``, ``H[10]=1``) becomes a named
+        command whose ``value`` parameter is the number, run before the
+        block's motion; a line starting ``NAME(arguments)``
+        (``CYCLE832(2,_finish,1)``) is a named command with the argument
+        text.  ``[codes]`` may map these names to commands.
     required_axes : str
         Letters every G0/G1 must carry; a motion missing one is reported
         (the Beckhoff DED dialect writes X, Y and Z on every move).
@@ -194,6 +201,7 @@ class Flavor:
     extended_commands: bool = False
     wizards: bool = False
     code_assignments: bool = False
+    assignments: bool = False
     directive_prefix: str = ""
     polar_words: bool = False
     polar_incremental_only: bool = False

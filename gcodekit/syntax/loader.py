@@ -264,11 +264,12 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
             raise ConfigError(
                 f"{path}: [words] {word}: maps to 'line_number' but line_number_letter is {letter!r}"
             )
-    if not get("extended_commands"):
+    if not (get("extended_commands") or get("assignments")):
         for code in codes:
             if not _GM_CODE.fullmatch(code):
                 raise ConfigError(
-                    f"{path}: [codes] {code}: extended command names need extended_commands = true"
+                    f"{path}: [codes] {code}: named commands need extended_commands = true "
+                    "(or assignments = true for Sinumerik names)"
                 )
     for key in ("string_codes", "other_codes"):
         for code in get(key):
