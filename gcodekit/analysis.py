@@ -316,7 +316,8 @@ def gcode_dataframe_to_event_series(df: "pd.DataFrame", source: str = "material"
     ----------
     df : DataFrame
         Needs ``x, y, z, de, distance, time, elapsed_time, motion`` (and
-        ``laser`` for ``source="heat"``).
+        ``laser`` for ``source="heat"``); an additive operation's frame also
+        has ``deposited_volume``, which then decides where material is laid.
     source : {"material", "heat"}, default: "material"
         ``material``: 1 while material is deposited (filament pushed on a
         move, or for DED a feed move with the heat source on); ``heat``: 1 while the laser/weld heat source is on during a move
@@ -349,7 +350,10 @@ def gcode_dataframe_to_event_series(df: "pd.DataFrame", source: str = "material"
     end_t = df["elapsed_time"].to_numpy(float)[moved]
     start_t = end_t - np.nan_to_num(df["time"].to_numpy(float)[moved])
     start_xyz = np.vstack([np.zeros((1, 3)), xyz[:-1]])[moved]
-    if source == "material":  # filament pushed, or (DED, no E words) the heat source on during a feed move
+    if source == "material" and "deposited_volume" in df:  # an additive operation's frame: screws, beads too
+        volume = df["deposited_volume"].to_numpy(float)[moved]
+        value = ((volume > 0) | np.isnan(volume)) & (df["distance"].to_numpy(float)[moved] > 0)
+    elif source == "material":  # filament pushed, or (DED, no E words) the heat source on during a feed move
         value = (df["de"].to_numpy(float)[moved] > 0) & (df["distance"].to_numpy(float)[moved] > 0)
         if "laser" in df:
             value |= (df["laser"].to_numpy()[moved] == 1) & (motion[moved] >= 2)

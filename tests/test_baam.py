@@ -75,3 +75,10 @@ def test_report_draws_the_screw_deposits():
 
     seg = toolpath_segments(gcodekit.gcode_to_operation(WALL))
     assert len(seg.start) == 8  # the two perimeters' eight sides, no travel
+
+
+def test_material_event_series_follows_the_screw():
+    events = analysis.gcode_dataframe_to_event_series(gcodekit.gcode_to_operation(WALL).to_dataframe())
+    on = events[events["value"] == 1.0]
+    assert len(on) == 8  # the eight perimeter sides, each an event with the screw turning
+    assert events["value"].iloc[-1] == 0.0

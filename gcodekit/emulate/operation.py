@@ -374,6 +374,14 @@ class AdditiveOperation(Operation):
 
     process_data_class = AdditiveProcessData
 
+    def to_dataframe(self) -> "pd.DataFrame":
+        """As :meth:`Operation.to_dataframe`, plus ``deposited_volume`` (mm^3,
+        NaN where material is laid in an unknown amount) once emulated."""
+        frame = super().to_dataframe()
+        if self.waypoints is not None:
+            frame["deposited_volume"] = self.deposited_volumes()
+        return frame
+
     @property
     def filament_area(self) -> float:
         d = self.machine.filament_diameter if self.machine else 1.75
