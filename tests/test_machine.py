@@ -33,6 +33,16 @@ def test_units_switch_mid_program():
     assert op.motions()["feed"].iloc[1] == pytest.approx(100 / 25.4)
 
 
+def test_units_keep_feed_keeps_the_f_number():
+    # rs274 standalone: "F30 G20" and a later G21 leave the F number alone (30 in/min, then 30 mm/min)
+    text = "G21 F30 G18 G20\nG1 X1\nG21\nG1 X30\n"
+    op, df = run(text, units_keep_feed=True)
+    assert op.motions()["feed"].tolist() == [30.0, 30.0]
+    assert df["time"].iloc[-1] == pytest.approx((30 - 25.4) / (30 / 60))
+    # by default the speed stays: 30 mm/min is 1.1811 in/min after G20
+    assert run(text)[0].motions()["feed"].tolist() == pytest.approx([30 / 25.4, 30.0])
+
+
 def test_incremental_and_absolute_mixed():
     op, _ = run("G21 G90 G0 X10 Y10\nG91 G1 X5 Y-2 F60\nX5\nG90 X0\n")
     assert op.process_data[-1].location[:2] == (0.0, 8.0)

@@ -69,7 +69,6 @@ _value _value_returned _task _call_level _remap_level
 #: Programs gcodekit knows it does not reproduce yet, and why.
 KNOWN_GAPS = {
     "nc_files/x-trim.ngc": "calls o<touchoff> from the plasma sample configuration, which probes (G38.2)",
-    "nc_files/lathecomp.ngc": "XZ-plane compensation of a lathe program: corner rule and feed differ (not modelled)",
 }
 
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
