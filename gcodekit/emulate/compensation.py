@@ -16,7 +16,9 @@ tool off it by the tool radius, after the rules of LinuxCNC's interpreter
   the XZ plane (G18) is compensated about its nose centre and then moved by
   the nose radius to the tool's control point, as rs274 does when it flushes
   its queue (interp_queue.cc ``latheorigin_x/z``); an entry arc first feeds
-  that shift on its own;
+  that shift on its own (when the next move turns a corner, rs274 moves the
+  end of that feed to the corner as well, so its arc ends where it starts:
+  gcodekit keeps the arc, matching rs274 only when the next move is tangent);
 * gouges are errors, as in rs274: an offset line that would run backwards
   between its corners, or an inside corner whose offset paths never meet.
 
