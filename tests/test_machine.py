@@ -383,13 +383,16 @@ def test_g16_under_ger_rules():
 
 
 def test_probe_moves_run_to_their_target():
-    # no probe input: G38.2 feeds all the way, like rs274 standalone; one going nowhere is refused
-    op = gcodekit.gcode_to_operation("G21 G0 Z5\nG38.2 Z-2 F50\nG38.3 Z-2\n", "linuxcnc", plan=False)
+    # no probe input: G38.2 feeds all the way, like rs274 standalone, and the tool then stands
+    # 0.254 mm back towards the start (Z-1.746); G38.5 may go nowhere, G38.4 may not (rs274 2.9)
+    text = "G21 G0 Z5\nG38.2 Z-2 F50\nG38.5 Z-1.746\nG38.4 Z-1.746\nM2\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
     m = op.motions()
-    assert m[["line", "motion", "z"]].values.tolist()[:2] == [[1, "rapid", 5], [2, "feed", -2]]
+    assert m[["line", "motion", "z"]].values.tolist()[:3] == [[1, "rapid", 5], [2, "feed", -2], [3, "feed", -1.746]]
+    assert op.to_dataframe()["distance"].iloc[3] == pytest.approx(0.0, abs=1e-12)  # the G38.5 goes nowhere
     assert m["feed"].iloc[1] == 50
     assert [(d.line, d.message) for d in op.diagnostics if d.severity == "error"] == [
-        (3, "Start point too close to probe point")]
+        (4, "Start point too close to probe point")]
 
 
 @pytest.mark.parametrize("move, message", [("G1 X2", "Cannot do g1 with zero feed rate"),
