@@ -20,7 +20,8 @@ import gcodekit
 from gcodekit.parse.table import NAME_ID
 
 CASES = Path(__file__).parent / "golden" / "linuxcnc" / "cases"
-PROGRAMS = sorted(p.name for p in CASES.glob("*.ngc"))
+# a case has its reference table; other .ngc files are subroutines a case calls (x-trim.ngc's touchoff.ngc)
+PROGRAMS = sorted(p.name for p in CASES.glob("*.ngc") if p.with_name(p.name + ".canon.csv").exists())
 ATOL, RTOL = 1e-4, 1e-9
 AXES = ["x", "y", "z", "a", "b", "c"]
 CENTRE = ["cx", "cy", "cz"]
