@@ -395,6 +395,28 @@ def test_probe_moves_run_to_their_target():
         (4, "Start point too close to probe point")]
 
 
+def test_probe_results_are_the_targets_as_rs274_standalone_sets_them():
+    # #5061-#5063: the target in program coordinates (G92 in force: X105, the machine's X5);
+    # #5070 (tripped) is 0, so the smartprobe.ngc-style loop runs once; values checked with rs274 2.9
+    text = "\n".join([
+        "G21 G90 F100", "G0 X0 Y0 Z10",
+        "G38.2 Z0",                      # tool stands at Z0.254 after it
+        "G0 X[#5063 + 7] Y[#5070 + 1]",  # X7 Y1
+        "G92 X100",                      # X7 is now X100
+        "#5070 = 1",
+        "o1 while [#5070 NE 0]",
+        "  G38.3 X105",                  # machine X12
+        "o1 endwhile",
+        "G1 X[#5061 - 50] Y#5062",       # X55 in the G92 frame: machine X-38
+        "G91 G1 Z1",                     # from the backed-off Z0.254
+        "M2"])
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+    m = op.motions()
+    expected = [(0, 0, 10), (0, 0, 0), (7, 1, 0.254), (12, 1, 0.254), (-38, 1, 0.254), (-38, 1, 1.254)]
+    np.testing.assert_allclose(m[["x", "y", "z"]].to_numpy(float), expected, atol=1e-12)
+    assert [d for d in op.diagnostics if d.severity == "error"] == []
+
+
 @pytest.mark.parametrize("move, message", [("G1 X2", "Cannot do g1 with zero feed rate"),
                                            ("G2 X3 I1", "Cannot make arc with zero feed rate")])
 def test_feed_moves_without_feed_are_refused_as_rs274_does(move, message):
