@@ -11,7 +11,9 @@ or ``order`` for moves rs274 emitted late), no rotary-axis work or G92 offset is
 only carries X/Y/Z offsets), its text (comments stripped) uses no feature
 gcodekit does not emulate yet (:data:`EXCLUDED_G`: lathe cycles, G33.1,
 G76; I/O M-codes, user or unknown
-codes, system parameters), and it is not a :data:`KNOWN_GAPS` program.
+codes, system parameters other than the probe results #5061-#5070), and it is
+not a :data:`KNOWN_GAPS` program; the subroutine files it calls by name and
+rs274 found beside it are scanned too and copied with it.
 
 Usage::
 
