@@ -26,7 +26,7 @@ import numpy as np
 from .emulate.machine import Machine
 from .emulate.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine
-from .errors import ConfigError, Diagnostics, check_choice
+from .errors import ConfigError, Diagnostics, GcodeError, check_choice
 from .parse import CommandTable, GcodeParser
 from .parse.table import NAME_ID
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
@@ -261,14 +261,14 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
                 out = _until_first_error(run_stages(source, stages, early), early)
                 if feedback is not None:
                     out = feedback.watch(out, stages[0].store)
-                yield read_source_lines(out, flavor, diagnostics), len(lines)
+                yield _MachineStop.read(out, flavor, diagnostics), len(lines)
                 diagnostics.extend(d for d in early if d.severity != "error")
                 early.raise_first()
                 return
             out = run_stages(source, stages, diagnostics)
             if feedback is not None:
                 out = feedback.watch(out, stages[0].store)
-            yield read_source_lines(out, flavor, diagnostics), len(lines)
+            yield _MachineStop.read(out, flavor, diagnostics), len(lines)
             return
         chunks: Iterator[bytes] = iter_lines(text)
     else:
@@ -320,7 +320,10 @@ class _ProbeResults:
         if self.pending and key in _PROBE_RESULTS:
             self.pending = False
             held, self.held = self.held, []
-            self.emulate(read_source_lines(held, self.flavor, self.diagnostics), 0)
+            try:
+                self.emulate(read_source_lines(held, self.flavor, self.diagnostics), 0)
+            except GcodeError as exc:  # strict mode: the machine's error, not the parameter stage's
+                raise _MachineStop(exc) from None
             result = self.machine.probe_result
             if result is not None:
                 for number, value in zip(range(5061, 5067), result):
@@ -328,6 +331,21 @@ class _ProbeResults:
                 for number in (5067, 5068, 5069, 5070):  # no U V W axes; never tripped
                     self.store.set(number, 0.0)
         return None  # they stay ordinary, writable parameters
+
+
+class _MachineStop(Exception):
+    """A machine error raised (strict mode) while the parameter stage waited for probe results."""
+
+    def __init__(self, error: GcodeError):
+        super().__init__(str(error))
+        self.error = error
+
+    @staticmethod
+    def read(lines: Iterator, flavor: Flavor, diagnostics: Diagnostics) -> Blocks:
+        try:
+            return read_source_lines(lines, flavor, diagnostics)
+        except _MachineStop as stop:
+            raise stop.error from None
 
 
 def _check_program_end(program: Program, table: CommandTable, n_lines: int, diagnostics: Diagnostics) -> None:
