@@ -206,7 +206,11 @@ class Machine:
         becomes :attr:`probe_result` (LinuxCNC's #5061-#5069; #5070, tripped,
         stays 0), and the tool then stands ``probe_backoff`` back towards
         the start without a move (saicanon.cc ``STRAIGHT_PROBE``: 0.01 inch
-        or 0.254 mm).  A real machine's results depend on the part.
+        or 0.254 mm).  A real machine's results depend on the part.  saicanon
+        takes that direction from the last point it was sent, in the frame
+        of then: after a G5x, G92 or tool offset change with no move in
+        between it can point elsewhere; gcodekit backs off towards the
+        probe's real start.
         """
         s = self.state
         target = s.position.copy()

@@ -26,6 +26,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 TOLERANCE_MM = 0.0001 * 25.4 * 2  # rs274 prints 4 decimals of inches or mm
 
+sys.path.insert(0, str(HERE.parents[2]))  # this checkout's gcodekit, not an installed one
 sys.path.insert(0, str(HERE.parents[1]))  # tests/, for the golden test's helpers
 sys.path.insert(0, str(HERE))  # regenerate.py, which runs rs274
 
