@@ -19,14 +19,14 @@ import os
 import re
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterator
+from typing import TYPE_CHECKING, Callable, Iterator
 
 import numpy as np
 
 from .emulate.machine import Machine
 from .emulate.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine
-from .errors import ConfigError, Diagnostics, check_choice
+from .errors import ConfigError, Diagnostics, GcodeError, check_choice
 from .parse import CommandTable, GcodeParser
 from .parse.table import NAME_ID
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
@@ -38,6 +38,9 @@ if TYPE_CHECKING:
 __all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate_operation", "resolve"]
 
 _O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
+_PROBE_LINE = re.compile(r"(?i)g\s*0*3\s*8\s*\.\s*[2-5]")  # G38.2 .. G38.5 in a preprocessed line
+_PROBE_PARAMETER = re.compile(r"#\s*50\s*[67]\s*\d")  # #5061 .. #5070, read or written
+_PROBE_RESULTS = range(5061, 5071)
 _PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
 
 
@@ -183,11 +186,16 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
                 polar_incremental_only=fl.polar_incremental_only)
     tables, waypoints, n_lines = [], [], 0
     bar = _progress(program, progress)
-    for blocks, lines in _blocks(program, fl, diagnostics, bar):
+
+    def emulate(blocks: Blocks, lines: int) -> None:
+        nonlocal n_lines
         table = parser.parse(blocks)
         tables.append(table)
         waypoints.append(m.run(table))
         n_lines += lines
+
+    for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate)):
+        emulate(blocks, lines)
     if bar is not None:
         bar.close()
     cls = OPERATION_CLASSES[config.process]
@@ -220,14 +228,24 @@ def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineCon
 # -- helpers -----------------------------------------------------------------------
 
 
-def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None) -> Iterator[tuple[Blocks, int]]:
-    """Blocks of the program chunk by chunk, preprocessed when it needs it."""
+def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None,
+            machine: tuple[Machine, Callable[[Blocks, int], None]] | None = None) -> Iterator[tuple[Blocks, int]]:
+    """Blocks of the program chunk by chunk, preprocessed when it needs it.
+
+    With ``machine`` (the machine and a function that parses and emulates
+    blocks), a program that reads probe results (#5061-#5070) is emulated up
+    to each probe move before the line after it is read, so the parameters
+    hold that probe's results (see :class:`_ProbeResults`).
+    """
     if flavor.parameters or flavor.wizards:
-        from .preprocess import ControlFlowStage, SourceLine, needs_parameters, run_stages
+        from .preprocess import ControlFlowStage, ParameterStore, SourceLine, needs_parameters, run_stages
         from .preprocess.wizards import WizardStage, needs_wizards
 
         text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
-        stages = [ControlFlowStage(flavor)] if flavor.parameters and (
+        probing = machine is not None and _PROBE_PARAMETER.search(text) and _PROBE_LINE.search(text)
+        feedback = _ProbeResults(flavor, diagnostics, *machine) if probing else None
+        store = ParameterStore(system=feedback.system) if feedback is not None else None
+        stages = [ControlFlowStage(flavor, store)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text)) else []
         stages += [WizardStage(flavor)] if flavor.wizards and needs_wizards(text) else []
         if stages:
@@ -241,12 +259,16 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
                 # preprocess error, in execution order, may fail first.
                 early = Diagnostics(diagnostics.file, "lenient")
                 out = _until_first_error(run_stages(source, stages, early), early)
-                yield read_source_lines(out, flavor, diagnostics), len(lines)
+                if feedback is not None:
+                    out = feedback.watch(out, stages[0].store)
+                yield _MachineStop.read(out, flavor, diagnostics), len(lines)
                 diagnostics.extend(d for d in early if d.severity != "error")
                 early.raise_first()
                 return
             out = run_stages(source, stages, diagnostics)
-            yield read_source_lines(out, flavor, diagnostics), len(lines)
+            if feedback is not None:
+                out = feedback.watch(out, stages[0].store)
+            yield _MachineStop.read(out, flavor, diagnostics), len(lines)
             return
         chunks: Iterator[bytes] = iter_lines(text)
     else:
@@ -262,6 +284,68 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
 
     for blocks in iter_blocks(counted(), flavor, diagnostics):
         yield blocks, sizes[-1]
+
+
+class _ProbeResults:
+    """LinuxCNC's probe results (#5061-#5070) for the parameter stage, from the machine.
+
+    rs274 sets them when it reads the block after a probe move
+    (``set_probe_data``): #5061-#5066 the X Y Z A B C where the probe
+    tripped, in program coordinates, #5067-#5069 U V W (0 here) and #5070 1
+    when it tripped.  Run standalone it has no probe input: every probe
+    "trips" at its target and #5070 is 0 (saicanon.cc), and so does
+    gcodekit (see ``Machine._after_probe``).  The lines the stages pass on
+    are held back and emulated as soon as a line after a probe touches one
+    of these parameters, then the results are written to the store.
+    """
+
+    def __init__(self, flavor: Flavor, diagnostics: Diagnostics, machine: Machine,
+                 emulate: Callable[[Blocks, int], None]):
+        self.flavor, self.diagnostics, self.machine, self.emulate = flavor, diagnostics, machine, emulate
+        self.held: list = []  # preprocessed lines not emulated yet
+        self.pending = False  # a held line probes: its results are not in the store yet
+        self.store = None
+
+    def watch(self, lines: Iterator, store) -> Iterator:
+        """Pass ``lines`` on, noting probe moves; yields only the lines left at the end."""
+        self.store = store
+        for line in lines:
+            self.held.append(line)
+            if _PROBE_LINE.search(line.text.split(";")[0].split("(")[0]):
+                self.pending = True
+        yield from self.held
+
+    def system(self, key: int | str) -> float | None:
+        """The store's system-parameter hook: brings probe results in before #5061-#5070 are used."""
+        if self.pending and key in _PROBE_RESULTS:
+            self.pending = False
+            held, self.held = self.held, []
+            try:
+                self.emulate(read_source_lines(held, self.flavor, self.diagnostics), 0)
+            except GcodeError as exc:  # strict mode: the machine's error, not the parameter stage's
+                raise _MachineStop(exc) from None
+            result = self.machine.probe_result
+            if result is not None:
+                for number, value in zip(range(5061, 5067), result):
+                    self.store.set(number, float(value))
+                for number in (5067, 5068, 5069, 5070):  # no U V W axes; never tripped
+                    self.store.set(number, 0.0)
+        return None  # they stay ordinary, writable parameters
+
+
+class _MachineStop(Exception):
+    """A machine error raised (strict mode) while the parameter stage waited for probe results."""
+
+    def __init__(self, error: GcodeError):
+        super().__init__(str(error))
+        self.error = error
+
+    @staticmethod
+    def read(lines: Iterator, flavor: Flavor, diagnostics: Diagnostics) -> Blocks:
+        try:
+            return read_source_lines(lines, flavor, diagnostics)
+        except _MachineStop as stop:
+            raise stop.error from None
 
 
 def _check_program_end(program: Program, table: CommandTable, n_lines: int, diagnostics: Diagnostics) -> None:

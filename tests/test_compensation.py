@@ -91,3 +91,52 @@ def test_gouging_is_refused_on_rs274s_line(name):
     table = Path(__file__).parent / "golden" / "linuxcnc" / "tooltables" / "simpockets.tbl"
     op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, tool_table=table, tool_table_units="inch")
     assert [(d.line, d.message) for d in op.diagnostics if d.severity == "error"] == [(6, message)]
+
+
+# Lathe tools in G18: a 2 mm nose (radius 1) with orientation Q2 or Q9.  In the
+# (Z, X) plane a -Z move has its right (G42) towards +X; the nose centre runs 1
+# mm off the profile and rs274 then moves every compensated point from the nose
+# centre to the tool's control point, (-1, -1) in (Z, X) for Q2 and nothing for
+# Q9 (interp_queue.cc latheorigin_z/x).  Values checked with LinuxCNC 2.9's rs274
+# (the same program in inches with the table in inches gives the same numbers).
+LATHE_PROGRAM = "G21 G18 G90 T{tool} M6\nG0 X10 Z5\nG42 G1 X5 F100\nG1 Z-10\nG40 G0 X10\nM2\n"
+
+
+@pytest.fixture
+def lathe_tools(tmp_path):
+    path = tmp_path / "lathe.tbl"
+    path.write_text("T2 P2 D2 Q2 ;front tool\nT3 P3 D2 Q9 ;nose centre\n")
+    return path
+
+
+@pytest.mark.parametrize("tool, nose_to_tip", [(3, (0, 0)), (2, (-1, -1))])
+def test_g42_in_g18_offsets_the_nose_then_the_control_point(lathe_tools, tool, nose_to_tip):
+    m = motions(LATHE_PROGRAM.format(tool=tool), lathe_tools)
+    dz, dx = nose_to_tip
+    # entry ends 1 to the right of the -X move (-Z), cut short where the -Z move's
+    # offset line X6 meets it (an inside corner); the -Z move runs on X6; the exit is plain
+    expected = [("rapid", 10, 5), ("feed", 6 + dx, 4 + dz), ("feed", 6 + dx, -10 + dz), ("rapid", 10, -10)]
+    assert m["motion"].tolist() == [e[0] for e in expected]
+    np.testing.assert_allclose(m[["x", "z"]].to_numpy(), [e[1:] for e in expected], atol=1e-12)
+    assert (m["plane"] == "XZ").all()
+
+
+def test_lathe_entry_arc_first_feeds_the_control_point_shift(lathe_tools):
+    # G41.1 D2 L3: nose radius 1, control point (-1, +1) from the nose centre in (Z, X);
+    # the entry arc (G2 R10 from Z10 X20 to Z0 X10) ends 1 left of its -Z tangent, at X9
+    text = "G21 G18 G90 F100\nG0 X20 Z10\nG41.1 D2 L3\nG2 X10 Z0 R10\nG1 Z-10\nG40 G0 X30\nM2\n"
+    m = motions(text, lathe_tools)
+    assert m["motion"].tolist() == ["rapid", "feed", "arc_cw", "feed", "rapid"]
+    np.testing.assert_allclose(m[["x", "z"]].to_numpy()[:4], [[20, 10], [21, 9], [10, -1], [10, -11]], atol=1e-9)
+    arc = m.iloc[2]
+    start, end, centre = np.array([9.0, 21.0]), np.array([-1.0, 10.0]), np.array([arc["cz"], arc["cx"]])
+    assert np.hypot(*(start - centre)) == pytest.approx(np.hypot(*(end - centre)))
+
+
+def test_tool_orientation_from_table_and_g10(lathe_tools):
+    from gcodekit.emulate.tooltable import ToolTable
+
+    assert ToolTable.read(lathe_tools)[2].orientation == 2
+    # G10 L1 Q gives T3 orientation 2: its path is then the Q2 one
+    m = motions(LATHE_PROGRAM.format(tool=3).replace("M6\n", "M6\nG10 L1 P3 Q2\n", 1), lathe_tools)
+    np.testing.assert_allclose(m[["x", "z"]].to_numpy()[1:3], [[5, 3], [5, -11]], atol=1e-12)

@@ -33,6 +33,16 @@ def test_units_switch_mid_program():
     assert op.motions()["feed"].iloc[1] == pytest.approx(100 / 25.4)
 
 
+def test_units_keep_feed_keeps_the_f_number():
+    # rs274 standalone: "F30 G20" and a later G21 leave the F number alone (30 in/min, then 30 mm/min)
+    text = "G21 F30 G18 G20\nG1 X1\nG21\nG1 X30\n"
+    op, df = run(text, units_keep_feed=True)
+    assert op.motions()["feed"].tolist() == [30.0, 30.0]
+    assert df["time"].iloc[-1] == pytest.approx((30 - 25.4) / (30 / 60))
+    # by default the speed stays: 30 mm/min is 1.1811 in/min after G20
+    assert run(text)[0].motions()["feed"].tolist() == pytest.approx([30 / 25.4, 30.0])
+
+
 def test_incremental_and_absolute_mixed():
     op, _ = run("G21 G90 G0 X10 Y10\nG91 G1 X5 Y-2 F60\nX5\nG90 X0\n")
     assert op.process_data[-1].location[:2] == (0.0, 8.0)
@@ -373,13 +383,38 @@ def test_g16_under_ger_rules():
 
 
 def test_probe_moves_run_to_their_target():
-    # no probe input: G38.2 feeds all the way, like rs274 standalone; one going nowhere is refused
-    op = gcodekit.gcode_to_operation("G21 G0 Z5\nG38.2 Z-2 F50\nG38.3 Z-2\n", "linuxcnc", plan=False)
+    # no probe input: G38.2 feeds all the way, like rs274 standalone, and the tool then stands
+    # 0.254 mm back towards the start (Z-1.746); G38.5 may go nowhere, G38.4 may not (rs274 2.9)
+    text = "G21 G0 Z5\nG38.2 Z-2 F50\nG38.5 Z-1.746\nG38.4 Z-1.746\nM2\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
     m = op.motions()
-    assert m[["line", "motion", "z"]].values.tolist()[:2] == [[1, "rapid", 5], [2, "feed", -2]]
+    assert m[["line", "motion", "z"]].values.tolist()[:3] == [[1, "rapid", 5], [2, "feed", -2], [3, "feed", -1.746]]
+    assert op.to_dataframe()["distance"].iloc[3] == pytest.approx(0.0, abs=1e-12)  # the G38.5 goes nowhere
     assert m["feed"].iloc[1] == 50
     assert [(d.line, d.message) for d in op.diagnostics if d.severity == "error"] == [
-        (3, "Start point too close to probe point")]
+        (4, "Start point too close to probe point")]
+
+
+def test_probe_results_are_the_targets_as_rs274_standalone_sets_them():
+    # #5061-#5063: the target in program coordinates (G92 in force: X105, the machine's X5);
+    # #5070 (tripped) is 0, so the smartprobe.ngc-style loop runs once; values checked with rs274 2.9
+    text = "\n".join([
+        "G21 G90 F100", "G0 X0 Y0 Z10",
+        "G38.2 Z0",                      # tool stands at Z0.254 after it
+        "G0 X[#5063 + 7] Y[#5070 + 1]",  # X7 Y1
+        "G92 X100",                      # X7 is now X100
+        "#5070 = 1",
+        "o1 while [#5070 NE 0]",
+        "  G38.3 X105",                  # machine X12
+        "o1 endwhile",
+        "G1 X[#5061 - 50] Y#5062",       # X55 in the G92 frame: machine X-38
+        "G91 G1 Z1",                     # from the backed-off Z0.254
+        "M2"])
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+    m = op.motions()
+    expected = [(0, 0, 10), (0, 0, 0), (7, 1, 0.254), (12, 1, 0.254), (-38, 1, 0.254), (-38, 1, 1.254)]
+    np.testing.assert_allclose(m[["x", "y", "z"]].to_numpy(float), expected, atol=1e-12)
+    assert [d for d in op.diagnostics if d.severity == "error"] == []
 
 
 @pytest.mark.parametrize("move, message", [("G1 X2", "Cannot do g1 with zero feed rate"),

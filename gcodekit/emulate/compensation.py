@@ -12,6 +12,13 @@ tool off it by the tool radius, after the rules of LinuxCNC's interpreter
   programmed corner on an arc of the tool radius, at an inside corner the
   previous move is cut short where the two shifted paths meet;
 * the first move after G40 (the exit) runs straight to its programmed end;
+* a lathe tool (orientation 1-8, the tool table's Q or G41.1/G42.1's L) in
+  the XZ plane (G18) is compensated about its nose centre and then moved by
+  the nose radius to the tool's control point, as rs274 does when it flushes
+  its queue (interp_queue.cc ``latheorigin_x/z``); an entry arc first feeds
+  that shift on its own (when the next move turns a corner, rs274 moves the
+  end of that feed to the corner as well, so its arc ends where it starts:
+  gcodekit keeps the arc, matching rs274 only when the next move is tangent);
 * gouges are errors, as in rs274: an offset line that would run backwards
   between its corners, or an inside corner whose offset paths never meet.
 
@@ -52,6 +59,9 @@ def compensate(op: "Operation", tools) -> None:
     columns["command"] = np.asarray(rows)  # corner arcs are added: every waypoint names its command
     out = {k: [] for k in columns}
     side, radius, mode = 0, 0.0, "off"  # mode: off, entry, on, exit
+    lathe = (0.0, 0.0)  # shift of a lathe tool's control point from its nose centre, in the plane
+    moved = (0.0, 0.0)  # the shift of the rows emitted now: ``lathe`` from the entry move to the exit move
+    lathe_rows: list[tuple[int, float, float, int]] = []  # (index in `out`, shift along a, along b, plane)
     last_dir = None  # tangent at the end of the previous compensated move
     last_path = None  # its offset path: ("line", point, direction) or ("arc", centre, radius)
     last_corner = None  # programmed end of the previous move
@@ -66,6 +76,8 @@ def compensate(op: "Operation", tools) -> None:
     def emit(k: int, **changes) -> int:
         for key in columns:
             out[key].append(changes.get(key, columns[key][k]))
+        if moved != (0.0, 0.0):
+            lathe_rows.append((len(out["x"]) - 1, *moved, int(columns["plane"][k])))
         return len(out["x"]) - 1
 
     for k in range(n):
@@ -81,15 +93,20 @@ def compensate(op: "Operation", tools) -> None:
                         params = t.command(r).params
                         if int(t.name[r]) in _DYNAMIC:
                             radius = params.get("D", 0.0) * (25.4 if columns["units"][k] == 1 else 1.0) / 2.0
+                            orientation = int(params.get("L", 0))
                         else:
                             number = int(params.get("D", columns["tool"][k]))
                             radius = tools[number].diameter / 2.0 if number in tools else 0.0
+                            orientation = tools[number].orientation if number in tools else 0
+                        plane = int(columns["plane"][k])
+                        lathe = _lathe_shift(orientation, radius) if plane == 18 else (0.0, 0.0)
                     elif not new and side:
                         side, mode = 0, "exit"
                 if r in tool_changes and mode == "exit" and out["x"]:
                     # rs274 re-reads its position after M6: the program position becomes
                     # the compensated one, so the exit starts from there (useful-subroutines.ngc)
-                    held = {a: out[a][-1], b: out[b][-1]}
+                    held = {a: out[a][-1] + moved[0], b: out[b][-1] + moved[1]}
+                    moved = (0.0, 0.0)  # `held` is where the tool is already
             current_row = row
         motion = int(columns["motion"][k])
         if held:
@@ -113,6 +130,7 @@ def compensate(op: "Operation", tools) -> None:
         end = np.array([columns[a][k], columns[b][k]])
         programmed_start = last_corner if last_corner is not None else start
         if mode == "exit":
+            moved = (0.0, 0.0)
             emit(k)  # straight from the compensated point to the programmed end
             mode, last_dir, last_corner, pending, last_path = "off", None, None, None, None
             pending_start, pending_dir = None, None
@@ -152,6 +170,16 @@ def compensate(op: "Operation", tools) -> None:
             entry_center = _meet(center, _unit(end - center), (start + new_end) / 2, _left(_unit(new_end - start)))
             if entry_center is None:
                 entry_center = center
+            moved = lathe
+            if lathe != (0.0, 0.0):
+                # rs274 feeds the tool's control point onto the shifted start first,
+                # or the entry would not be an arc (convert_arc_comp1)
+                length = float(np.hypot(*lathe))
+                feed = float(columns["feed"][k])
+                h = "xyz"[3 - f - g]
+                emit(k, **{a: start[0], b: start[1], h: out[h][-1] if out["x"] else 0.0, "motion": MOTION_LINEAR,
+                           "cx": np.nan, "cy": np.nan, "cz": np.nan, "distance": length, "de": 0.0,
+                           "time": length / (feed / 60.0) if feed > 0 else 0.0})
             pending = emit(k, **{a: new_end[0], b: new_end[1], ca: entry_center[0], cb: entry_center[1]})
             pending_start, pending_dir = start, None
             mode, last_dir, last_corner = "on", out_dir, end
@@ -160,6 +188,7 @@ def compensate(op: "Operation", tools) -> None:
         if mode == "entry":
             # comp1: straight to the end shifted off the entry move's own direction
             shifted = end + _left(_unit(chord)) * side * radius
+            moved = lathe
             pending = emit(k, **{a: shifted[0], b: shifted[1]})
             pending_start, pending_dir = start, _unit(chord)
             mode, last_dir, last_corner = "on", _unit(chord), end
@@ -194,9 +223,30 @@ def compensate(op: "Operation", tools) -> None:
         pending = emit(k, **{a: new_end[0], b: new_end[1], ca: centre[0], cb: centre[1]})
         pending_start, pending_dir = new_start, (None if motion in (MOTION_CW, MOTION_CCW) else in_dir)
         last_dir, last_corner, last_path = out_dir, end, this_path
+    for i, da, db, plane in lathe_rows:
+        (f, g, _), _ = PLANES[plane]
+        for axis, shift in (("xyz"[f], da), ("xyz"[g], db)):
+            out[axis][i] += shift
+            out["c" + axis][i] += shift  # NaN off arcs stays NaN
     for key in columns:
         w[key] = np.asarray(out[key], dtype=columns[key].dtype)
     _recompute_lengths(w)
+
+
+def _lathe_shift(orientation: int, radius: float) -> tuple[float, float]:
+    """(Z, X) from a lathe tool's nose centre to its control point (interp_queue.cc ``latheorigin_z/x``).
+
+    Orientations 0 (a mill tool) and 9 (the control point is the nose centre)
+    need no shift.
+
+    >>> _lathe_shift(2, 0.5)
+    (-0.5, -0.5)
+    >>> _lathe_shift(7, 0.5)
+    (-0.5, 0.0)
+    """
+    dz = -radius if orientation in (2, 7, 3) else radius if orientation in (1, 5, 4) else 0.0
+    dx = -radius if orientation in (2, 6, 1) else radius if orientation in (3, 8, 4) else 0.0
+    return dz, dx
 
 
 def _leaves_plane(columns: dict, k: int, f: int, g: int) -> bool:

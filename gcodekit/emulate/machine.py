@@ -109,6 +109,9 @@ class Machine:
         self._straight_ids = np.array([NAME_ID["rapid"], NAME_ID["linear"]], np.uint8)
         self._table_z, self._table_w = np.nan, 0.0  # last Z and table-axis words (see _part_frame)
         self._warned: set[str] = set()
+        #: Where the last probe move (G38.2-G38.5) "tripped": its target in program
+        #: coordinates and units, X Y Z A B C (see :meth:`_after_probe`); None before one.
+        self.probe_result: np.ndarray | None = None
 
     # -- running ----------------------------------------------------------------
 
@@ -172,14 +175,20 @@ class Machine:
                 special |= ~np.isnan(table.param(letter)) & np.isin(table.kind, _MOVING)
         if self.config.block_delete and table.deleted.size:
             special[table.deleted] = True
+        probing = (table.name == NAME_ID["probe"]) & ~special
         extra: list[tuple[int, Waypoint]] = []
         cursor = 0
-        for row in np.flatnonzero(special).tolist():
+        for row in np.flatnonzero(special | probing).tolist():
             if self.state.ended:
                 break
             if row > cursor:
                 self._run_segment(table, cursor, row, out)
-            extra += [(row, w) for w in self.modal.apply(table, row, out)]
+            if probing[row]:
+                start = self.state.position.copy()
+                self._run_segment(table, row, row + 1, out)
+                self._after_probe(start)
+            else:
+                extra += [(row, w) for w in self.modal.apply(table, row, out)]
             cursor = row + 1
         if cursor < n and not self.state.ended:
             self._run_segment(table, cursor, n, out)
@@ -190,10 +199,33 @@ class Machine:
             self._once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
         return _constants_as_views(_with_extra_waypoints(out, extra, n))
 
+    def _after_probe(self, start: np.ndarray) -> None:
+        """Where a probe move leaves the machine, as rs274 run standalone has it.
+
+        With no probe input the move always "trips" at its target, which
+        becomes :attr:`probe_result` (LinuxCNC's #5061-#5069; #5070, tripped,
+        stays 0), and the tool then stands ``probe_backoff`` back towards
+        the start without a move (saicanon.cc ``STRAIGHT_PROBE``: 0.01 inch
+        or 0.254 mm).  A real machine's results depend on the part.  saicanon
+        takes that direction from the last point it was sent, in the frame
+        of then: after a G5x, G92 or tool offset change with no move in
+        between it can point elsewhere; gcodekit backs off towards the
+        probe's real start.
+        """
+        s = self.state
+        target = s.position.copy()
+        self.probe_result = (target - s.offset + s.program_shift) / s.scale()
+        back = start[:3] - target[:3]
+        length = float(np.linalg.norm(back))
+        if length > 0 and self.config.probe_backoff > 0:
+            s.position[:3] = target[:3] + back / length * self.config.probe_backoff
+
     def _check_probes(self, t: CommandTable, start: int, moving: np.ndarray, start_pos: np.ndarray,
                       position: np.ndarray) -> None:
-        """A probe move (G38.x) must go somewhere: rs274 refuses one that starts at its target."""
-        probes = np.flatnonzero(moving & (t.name[start:start + moving.size] == NAME_ID["probe"]))
+        """A probe towards or away from the part (G38.2, G38.4) must go somewhere: rs274 refuses
+        one that starts at its target; G38.3 and G38.5, which need no contact, may."""
+        probes = np.flatnonzero(moving & (t.name[start:start + moving.size] == NAME_ID["probe"])
+                                & np.isin(t.number[start:start + moving.size], (382, 384)))
         for i in probes[np.all(np.abs(position[probes] - start_pos[probes]) < 1e-9, axis=1)].tolist():
             self.diagnostics.report(int(t.line[start + i]), 1, "Start point too close to probe point", kind="machine")
 

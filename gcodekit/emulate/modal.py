@@ -103,9 +103,11 @@ class ModalHandler:
         if self.machine.config.block_delete and row in set(t.deleted.tolist()):
             self._write(out, row, before, MOTION_NONE)
             return []
+        keep_feed = self.machine.config.units_keep_feed
         if "F" in params and (chr(int(t.letter[row])) != "M" or self.machine.rs274_blocks):
-            # an F beside G20/G21 is in the block's new units (rs274: "G20 F60" is 60 in/min)
-            units = _SIMPLE[name][1] if name in ("units_inch", "units_mm") else s.units
+            # an F beside G20/G21 is in the block's new units ("G20 F60" is 60 in/min);
+            # where the units change keeps the F number, that follows below
+            units = _SIMPLE[name][1] if name in ("units_inch", "units_mm") and not keep_feed else s.units
             s.feed = params["F"] * units
         moves = int(t.kind[row]) in _MOVING_KINDS
         if s.polar and self.machine.polar_incremental_only and (name in _PROGRAM_ZERO or
@@ -134,6 +136,8 @@ class ModalHandler:
             s.cycle.retract_to_r = name == "retract_r"
         elif name in _SIMPLE:
             attr, value = _SIMPLE[name]
+            if attr == "units" and keep_feed:
+                s.feed *= value / s.units  # the same F number in the new units
             setattr(s, attr, value)
             if attr == "incremental" and self.machine.config.distance_mode_sets_extrusion:
                 s.e_relative = value
@@ -407,6 +411,8 @@ class ModalHandler:
                     tool.offset[ax] = s.position[ax] - system[ax] - g92 - value
             if "R" in params:
                 tool.diameter = 2 * params["R"] * s.units
+            if "Q" in params:
+                tool.orientation = int(params["Q"])
         else:
             self.machine.diagnostics.report(line, 1, "G10 needs L1, L2, L10, L11 or L20", kind="machine")
 

@@ -68,6 +68,18 @@ class MachineConfig:
     empty_moves : bool
         A G0/G1 with no axis words still makes a zero-length move (LinuxCNC's
         interpreter does; firmware only updates the mode and feed).
+    probe_backoff : float
+        mm; after a probe move (G38.2-G38.5), which gcodekit lets "trip" at
+        its target, the tool stands this far back towards the start without
+        a move: 0.254 (0.01 inch) in rs274 run standalone, 0 leaves it at
+        the target.
+    units_keep_feed : bool
+        G20/G21 keep the F number, so the rate changes with the units: ``F30
+        G20`` feeds at 30 in/min.  rs274 run standalone does this (its canon
+        hands back the number it was given when the interpreter re-reads the
+        feed, interp_convert.cc ``convert_length_units``; the LinuxCNC golden
+        tests turn it on); LinuxCNC's task, which converts the rate it holds,
+        and printer firmware keep the speed (false, the default).
     distance_mode_sets_extrusion : bool
         G90/G91 also switch E to absolute/relative, overriding M82/M83
         (Marlin, RepRapFirmware).  Everywhere, E is relative under G91.
@@ -128,6 +140,8 @@ class MachineConfig:
     tool_change_on: str = "M6"
     radius_arcs: bool = True
     empty_moves: bool = False
+    probe_backoff: float = 0.0
+    units_keep_feed: bool = False
     distance_mode_sets_extrusion: bool = False
     block_delete: bool = False
     filament_diameter: float = 1.75

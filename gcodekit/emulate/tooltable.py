@@ -28,13 +28,19 @@ _AXES = "XYZABC"
 
 @dataclass
 class Tool:
-    """One tool: offsets along X..C (mm, degrees) and diameter (mm)."""
+    """One tool: offsets along X..C (mm, degrees), diameter (mm) and lathe orientation.
+
+    ``orientation`` is the Q word, LinuxCNC's lathe tool orientation 1-9
+    (where the tool tip's control point sits on the nose radius); 0 is a
+    mill tool.
+    """
 
     number: int
     pocket: int = 0
     offset: np.ndarray = field(default_factory=lambda: np.zeros(6))
     diameter: float = 0.0
     comment: str = ""
+    orientation: int = 0
 
 
 class ToolTable(dict):
@@ -56,7 +62,7 @@ class ToolTable(dict):
                 raise ConfigError(f"{source}:{number}: a tool table line needs a T word: {raw.strip()!r}")
             offset = np.array([words.get(a, 0.0) * (scale if a in "XYZ" else 1.0) for a in _AXES])
             tool = Tool(int(words["T"]), int(words.get("P", 0)), offset, words.get("D", 0.0) * scale,
-                        comment.strip())
+                        comment.strip(), int(words.get("Q", 0)))
             table[tool.number] = tool
         return table
 

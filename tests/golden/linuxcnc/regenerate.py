@@ -11,7 +11,9 @@ or ``order`` for moves rs274 emitted late), no rotary-axis work or G92 offset is
 only carries X/Y/Z offsets), its text (comments stripped) uses no feature
 gcodekit does not emulate yet (:data:`EXCLUDED_G`: G33.1,
 G76; I/O M-codes, user or unknown
-codes, system parameters), and it is not a :data:`KNOWN_GAPS` program.
+codes, system parameters other than the probe results #5061-#5070), and it is
+not a :data:`KNOWN_GAPS` program; the subroutine files it calls by name and
+rs274 found beside it are scanned too and copied with it.
 
 Usage::
 
@@ -53,7 +55,8 @@ LETTER_RUN = re.compile(r"[A-Z]{2,}")  # functions, operators and O-word keyword
 CODE = re.compile(r"(?<![A-Z])([GM])(\d+(?:\.\d+)?)")
 COMPUTED_CODE = re.compile(r"(?<![A-Z])[GM][\[#]")
 LATHE_CYCLE = re.compile(r"(?<![A-Z])G0*7[012](?:\.[12])?(?![0-9.])")
-SYSTEM_NUMBERED = re.compile(r"#5\d{3}(?!\d)")
+SYSTEM_NUMBERED = re.compile(r"#5(?!06[1-9]|070)\d{3}(?!\d)")  # probe results #5061-#5070 are emulated
+CALL = re.compile(r"o\s*<\s*([^>]*?)\s*>\s*call", re.I)  # a subroutine called by name
 
 #: Predefined (read-only) named parameters of LinuxCNC 2.9.
 SYSTEM_NAMED = frozenset("""
@@ -69,10 +72,8 @@ _value _value_returned _task _call_level _remap_level
 
 #: Programs gcodekit knows it does not reproduce yet, and why.
 KNOWN_GAPS = {
-    "nc_files/x-trim.ngc": "calls o<touchoff> from the plasma sample configuration, which probes (G38.2)",
     "nc_files/lathe_g70_71_demo.ngc": "its G70 runs under G42.1: XZ-plane compensation of the finishing pass differs "
                                       "(the G71.1/G71.2 roughing, motions 1-191, matches)",
-    "nc_files/lathecomp.ngc": "XZ-plane compensation of a lathe program: corner rule and feed differ (not modelled)",
 }
 
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
@@ -86,9 +87,10 @@ ALLOWED_G = frozenset("""
 98 99
 """.split())
 EXCLUDED_M = {
-    **dict.fromkeys(tuple(str(n) for n in range(62, 69)), "digital/analog I/O"),
+    # M66 (wait for an input) returns at once in rs274 standalone: only reading #5399 would matter
+    **dict.fromkeys(("62", "63", "64", "65", "67", "68"), "digital/analog I/O"),
 }
-ALLOWED_M = frozenset("0 1 2 3 4 5 6 7 8 9 19 30 48 49 50 51 52 53 60 61 70 71 72 73".split())
+ALLOWED_M = frozenset("0 1 2 3 4 5 6 7 8 9 19 30 48 49 50 51 52 53 60 61 66 70 71 72 73".split())
 
 
 @dataclass
@@ -99,6 +101,7 @@ class Entry:
     motions: int
     golden: bool
     reason: str
+    subroutines: tuple[Path, ...] = ()  # files of subroutines it calls, copied next to the case
 
 
 def normalize(code: str) -> str:
@@ -198,6 +201,11 @@ def judge(corpus: Path, row: dict[str, str], tables: dict[str, Path],
         error = " ".join(row["error"].split())[:80]
         return Entry(program, int(row["motions"] or 0), False, f"rs274 {row['status']}: {error}")
     reasons, used = scan_text(path.read_text(errors="replace"))
+    subroutines = called_files(path)
+    for sub in subroutines:  # rs274 ran in the program's directory and found these there
+        more, more_used = scan_text(sub.read_text(errors="replace"))
+        reasons += [f"{why} in {sub.name}" for why in more]
+        used = sorted(set(used) | set(more_used), key=lambda c: (c[0], float(c[1:])))
     canon = path.with_name(path.name + ".canon")
     if rerun_dir is not None and not reasons:
         canon = rerun_dir / (case_name(program) + ".canon")
@@ -207,7 +215,23 @@ def judge(corpus: Path, row: dict[str, str], tables: dict[str, Path],
     reasons += csv_reasons
     if program in KNOWN_GAPS:
         reasons.append(KNOWN_GAPS[program])
-    return Entry(program, motions, not reasons, "; ".join(reasons) or "uses " + " ".join(used))
+    return Entry(program, motions, not reasons, "; ".join(reasons) or "uses " + " ".join(used),
+                 tuple(subroutines))
+
+
+def called_files(path: Path) -> list[Path]:
+    """Files ``name.ngc`` beside ``path`` of the subroutines it calls by name but does not define."""
+    found: list[Path] = []
+    todo = [path]
+    while todo:
+        text = "\n".join(COMMENT.sub("", line) for line in todo.pop().read_text(errors="replace").splitlines())
+        defined = {m.lower() for m in re.findall(r"o\s*<\s*([^>]*?)\s*>\s*sub", text, re.I)}
+        for name in CALL.findall(text):
+            sub = path.with_name(name.lower() + ".ngc")
+            if name.lower() not in defined and sub.exists() and sub not in found:
+                found.append(sub)
+                todo.append(sub)
+    return found
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -234,6 +258,9 @@ def main(argv: list[str] | None = None) -> int:
         CASES.mkdir(exist_ok=True)
         for old in CASES.iterdir():
             old.unlink()
+        for entry in entries:
+            for sub in entry.subroutines if entry.golden else ():
+                shutil.copyfile(sub, CASES / sub.name)  # found beside the case, as rs274 found it
         for program in chosen:
             name = case_name(program)
             fresh = Path(tmp) / (name + ".canon.csv")
