@@ -296,14 +296,17 @@ class _ProbeResults:
     "trips" at its target and #5070 is 0 (saicanon.cc), and so does
     gcodekit (see ``Machine._after_probe``).  The lines the stages pass on
     are held back and emulated as soon as a line after a probe touches one
-    of these parameters, then the results are written to the store.
+    of these parameters, then the results of the last probe emulated since
+    the previous time are written to the store (axis words alone after a
+    G38.x probe again, so any held line may have probed).
     """
 
     def __init__(self, flavor: Flavor, diagnostics: Diagnostics, machine: Machine,
                  emulate: Callable[[Blocks, int], None]):
         self.flavor, self.diagnostics, self.machine, self.emulate = flavor, diagnostics, machine, emulate
         self.held: list = []  # preprocessed lines not emulated yet
-        self.pending = False  # a held line probes: its results are not in the store yet
+        self.probed = False  # a probe line went by: held lines may probe
+        self.applied = 0  # probes whose results went to the store
         self.store = None
 
     def watch(self, lines: Iterator, store) -> Iterator:
@@ -312,20 +315,20 @@ class _ProbeResults:
         for line in lines:
             self.held.append(line)
             if _PROBE_LINE.search(line.text.split(";")[0].split("(")[0]):
-                self.pending = True
+                self.probed = True
         yield from self.held
 
     def system(self, key: int | str) -> float | None:
         """The store's system-parameter hook: brings probe results in before #5061-#5070 are used."""
-        if self.pending and key in _PROBE_RESULTS:
-            self.pending = False
+        if self.probed and self.held and key in _PROBE_RESULTS:
             held, self.held = self.held, []
             try:
                 self.emulate(read_source_lines(held, self.flavor, self.diagnostics), 0)
             except GcodeError as exc:  # strict mode: the machine's error, not the parameter stage's
                 raise _MachineStop(exc) from None
             result = self.machine.probe_result
-            if result is not None:
+            if self.machine.probes > self.applied:
+                self.applied = self.machine.probes
                 for number, value in zip(range(5061, 5067), result):
                     self.store.set(number, float(value))
                 for number in (5067, 5068, 5069, 5070):  # no U V W axes; never tripped
