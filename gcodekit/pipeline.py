@@ -39,7 +39,6 @@ __all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "em
 
 _O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
 _PROBE_LINE = re.compile(r"(?i)g\s*0*3\s*8\s*\.\s*[2-5]")  # G38.2 .. G38.5 in a preprocessed line
-_PROBE_PARAMETER = re.compile(r"#\s*50\s*[67]\s*\d")  # #5061 .. #5070, read or written
 _PROBE_RESULTS = range(5061, 5071)
 _PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
 
@@ -233,8 +232,8 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
     """Blocks of the program chunk by chunk, preprocessed when it needs it.
 
     With ``machine`` (the machine and a function that parses and emulates
-    blocks), a program that reads probe results (#5061-#5070) is emulated up
-    to each probe move before the line after it is read, so the parameters
+    blocks), a program that probes is emulated up to its latest probe move
+    whenever a line reads or writes the probe results (#5061-#5070), so they
     hold that probe's results (see :class:`_ProbeResults`).
     """
     if flavor.parameters or flavor.wizards:
@@ -242,11 +241,14 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         from .preprocess.wizards import WizardStage, needs_wizards
 
         text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
-        probing = machine is not None and _PROBE_PARAMETER.search(text) and _PROBE_LINE.search(text)
-        feedback = _ProbeResults(flavor, diagnostics, *machine) if probing else None
+        # probes and reads of their results may sit in subroutine files: watch every program
+        # (until a probe goes by, the watch only collects the lines)
+        feedback = _ProbeResults(flavor, diagnostics, *machine) if machine is not None else None
         store = ParameterStore(system=feedback.system) if feedback is not None else None
         stages = [ControlFlowStage(flavor, store)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text)) else []
+        if not stages:
+            feedback = None  # no parameters to bring probe results to
         stages += [WizardStage(flavor)] if flavor.wizards and needs_wizards(text) else []
         if stages:
             program.preprocessed = True
@@ -260,14 +262,14 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
                 early = Diagnostics(diagnostics.file, "lenient")
                 out = _until_first_error(run_stages(source, stages, early), early)
                 if feedback is not None:
-                    out = feedback.watch(out, stages[0].store)
+                    out = feedback.watch(out, store)
                 yield _MachineStop.read(out, flavor, diagnostics), len(lines)
                 diagnostics.extend(d for d in early if d.severity != "error")
                 early.raise_first()
                 return
             out = run_stages(source, stages, diagnostics)
             if feedback is not None:
-                out = feedback.watch(out, stages[0].store)
+                out = feedback.watch(out, store)
             yield _MachineStop.read(out, flavor, diagnostics), len(lines)
             return
         chunks: Iterator[bytes] = iter_lines(text)
