@@ -433,3 +433,12 @@ def test_feed_moves_without_feed_are_refused_as_rs274_does(move, message):
     # messages as rs274 2.9 prints them for these programs
     op = gcodekit.gcode_to_operation(f"G21 G0 X1\n{move}\nM2\n", "linuxcnc", plan=False)
     assert [(d.line, d.severity, d.message) for d in op.diagnostics] == [(2, "error", message)]
+
+
+def test_probe_results_from_a_subroutine_file(tmp_path):
+    # the probe sits in myprobe.ngc beside the program; rs274 2.9 rapids to X7 Z-2.746
+    (tmp_path / "myprobe.ngc").write_text("o<myprobe> sub\nG38.2 Z#1\no<myprobe> endsub\nM2\n")
+    main = tmp_path / "main.ngc"
+    main.write_text("G21 F50\no<myprobe> call [-3]\nG0 X[#5063 + 10]\nM2\n")
+    op = gcodekit.gcode_to_operation(main, "linuxcnc", plan=False)
+    np.testing.assert_allclose(op.motions()[["x", "z"]].to_numpy(float), [(0, -3), (7, -2.746)], atol=1e-12)
