@@ -39,7 +39,6 @@ __all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "em
 
 _O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
 _PROBE_LINE = re.compile(r"(?i)g\s*0*3\s*8\s*\.\s*[2-5]")  # G38.2 .. G38.5 in a preprocessed line
-_PROBE_PARAMETER = re.compile(r"#\s*50\s*[67]\s*\d")  # #5061 .. #5070, read or written
 _PROBE_RESULTS = range(5061, 5071)
 _PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
 
@@ -233,8 +232,8 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
     """Blocks of the program chunk by chunk, preprocessed when it needs it.
 
     With ``machine`` (the machine and a function that parses and emulates
-    blocks), a program that reads probe results (#5061-#5070) is emulated up
-    to each probe move before the line after it is read, so the parameters
+    blocks), a program that probes is emulated up to its latest probe move
+    whenever a line reads or writes the probe results (#5061-#5070), so they
     hold that probe's results (see :class:`_ProbeResults`).
     """
     if flavor.parameters or flavor.wizards:
@@ -242,11 +241,14 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         from .preprocess.wizards import WizardStage, needs_wizards
 
         text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
-        probing = machine is not None and _PROBE_PARAMETER.search(text) and _PROBE_LINE.search(text)
-        feedback = _ProbeResults(flavor, diagnostics, *machine) if probing else None
+        # probes and reads of their results may sit in subroutine files: watch every program
+        # (until a probe goes by, the watch only collects the lines)
+        feedback = _ProbeResults(flavor, diagnostics, *machine) if machine is not None else None
         store = ParameterStore(system=feedback.system) if feedback is not None else None
         stages = [ControlFlowStage(flavor, store)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text)) else []
+        if not stages:
+            feedback = None  # no parameters to bring probe results to
         stages += [WizardStage(flavor)] if flavor.wizards and needs_wizards(text) else []
         if stages:
             program.preprocessed = True
@@ -260,14 +262,14 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
                 early = Diagnostics(diagnostics.file, "lenient")
                 out = _until_first_error(run_stages(source, stages, early), early)
                 if feedback is not None:
-                    out = feedback.watch(out, stages[0].store)
+                    out = feedback.watch(out, store)
                 yield _MachineStop.read(out, flavor, diagnostics), len(lines)
                 diagnostics.extend(d for d in early if d.severity != "error")
                 early.raise_first()
                 return
             out = run_stages(source, stages, diagnostics)
             if feedback is not None:
-                out = feedback.watch(out, stages[0].store)
+                out = feedback.watch(out, store)
             yield _MachineStop.read(out, flavor, diagnostics), len(lines)
             return
         chunks: Iterator[bytes] = iter_lines(text)
@@ -296,14 +298,17 @@ class _ProbeResults:
     "trips" at its target and #5070 is 0 (saicanon.cc), and so does
     gcodekit (see ``Machine._after_probe``).  The lines the stages pass on
     are held back and emulated as soon as a line after a probe touches one
-    of these parameters, then the results are written to the store.
+    of these parameters, then the results of the last probe emulated since
+    the previous time are written to the store (axis words alone after a
+    G38.x probe again, so any held line may have probed).
     """
 
     def __init__(self, flavor: Flavor, diagnostics: Diagnostics, machine: Machine,
                  emulate: Callable[[Blocks, int], None]):
         self.flavor, self.diagnostics, self.machine, self.emulate = flavor, diagnostics, machine, emulate
         self.held: list = []  # preprocessed lines not emulated yet
-        self.pending = False  # a held line probes: its results are not in the store yet
+        self.probed = False  # a probe line went by: held lines may probe
+        self.applied = 0  # probes whose results went to the store
         self.store = None
 
     def watch(self, lines: Iterator, store) -> Iterator:
@@ -312,20 +317,20 @@ class _ProbeResults:
         for line in lines:
             self.held.append(line)
             if _PROBE_LINE.search(line.text.split(";")[0].split("(")[0]):
-                self.pending = True
+                self.probed = True
         yield from self.held
 
     def system(self, key: int | str) -> float | None:
         """The store's system-parameter hook: brings probe results in before #5061-#5070 are used."""
-        if self.pending and key in _PROBE_RESULTS:
-            self.pending = False
+        if self.probed and self.held and key in _PROBE_RESULTS:
             held, self.held = self.held, []
             try:
                 self.emulate(read_source_lines(held, self.flavor, self.diagnostics), 0)
             except GcodeError as exc:  # strict mode: the machine's error, not the parameter stage's
                 raise _MachineStop(exc) from None
             result = self.machine.probe_result
-            if result is not None:
+            if self.machine.probes > self.applied:
+                self.applied = self.machine.probes
                 for number, value in zip(range(5061, 5067), result):
                     self.store.set(number, float(value))
                 for number in (5067, 5068, 5069, 5070):  # no U V W axes; never tripped

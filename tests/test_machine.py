@@ -417,9 +417,28 @@ def test_probe_results_are_the_targets_as_rs274_standalone_sets_them():
     assert [d for d in op.diagnostics if d.severity == "error"] == []
 
 
+def test_axis_words_after_a_probe_probe_again():
+    # G38.x is a motion mode: "Z-2" after "G38.3 Z-1" is a second probe (its results, its backoff);
+    # rs274 2.9 gives X8 Y-1 Z-1.746 for the rapid
+    text = "G21 F50\nG38.3 Z-1\n#1 = #5063\nZ-2\nG0 X[#5063 + 10] Y#1\nG91 G1 X1\nM2\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+    assert op.table.number[op.table.line == 4].tolist() == [383]
+    np.testing.assert_allclose(op.motions()[["x", "y", "z"]].to_numpy(float),
+                               [(0, 0, -1), (0, 0, -2), (8, -1, -1.746), (9, -1, -1.746)], atol=1e-12)
+
+
 @pytest.mark.parametrize("move, message", [("G1 X2", "Cannot do g1 with zero feed rate"),
                                            ("G2 X3 I1", "Cannot make arc with zero feed rate")])
 def test_feed_moves_without_feed_are_refused_as_rs274_does(move, message):
     # messages as rs274 2.9 prints them for these programs
     op = gcodekit.gcode_to_operation(f"G21 G0 X1\n{move}\nM2\n", "linuxcnc", plan=False)
     assert [(d.line, d.severity, d.message) for d in op.diagnostics] == [(2, "error", message)]
+
+
+def test_probe_results_from_a_subroutine_file(tmp_path):
+    # the probe sits in myprobe.ngc beside the program; rs274 2.9 rapids to X7 Z-2.746
+    (tmp_path / "myprobe.ngc").write_text("o<myprobe> sub\nG38.2 Z#1\no<myprobe> endsub\nM2\n")
+    main = tmp_path / "main.ngc"
+    main.write_text("G21 F50\no<myprobe> call [-3]\nG0 X[#5063 + 10]\nM2\n")
+    op = gcodekit.gcode_to_operation(main, "linuxcnc", plan=False)
+    np.testing.assert_allclose(op.motions()[["x", "z"]].to_numpy(float), [(0, -3), (7, -2.746)], atol=1e-12)

@@ -112,6 +112,7 @@ class Machine:
         #: Where the last probe move (G38.2-G38.5) "tripped": its target in program
         #: coordinates and units, X Y Z A B C (see :meth:`_after_probe`); None before one.
         self.probe_result: np.ndarray | None = None
+        self.probes = 0  # probe moves run so far
 
     # -- running ----------------------------------------------------------------
 
@@ -215,6 +216,7 @@ class Machine:
         s = self.state
         target = s.position.copy()
         self.probe_result = (target - s.offset + s.program_shift) / s.scale()
+        self.probes += 1
         back = start[:3] - target[:3]
         length = float(np.linalg.norm(back))
         if length > 0 and self.config.probe_backoff > 0:

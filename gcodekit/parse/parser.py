@@ -57,6 +57,7 @@ class GcodeParser:
         self.flavor = load_flavor(flavor) if isinstance(flavor, str) else flavor
         self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
         self.motion = MOTION_OF_NAME.get(self.flavor.initial_motion, MOTION_NONE)
+        self.probe = -1  # code number (382 .. 385) of the probe mode in force, -1 for none
         self._n_letter = ord(self.flavor.line_number_letter) if self.flavor.line_number_letter else -1
         self._modal = self.flavor.block_split == "modal"
         self._modal_motion = self.flavor.block_split != "single"  # firmware needs a code on every move
@@ -283,8 +284,13 @@ class GcodeParser:
             if part is not None and part.motion:
                 sets[i] = MOTION_OF_NAME.get(part.motion, _KEEP)
         motion = _forward_fill_modes(sets, self.motion)
+        # G38.x is a motion mode too: axis words alone after it probe again (rs274)
+        probe_sets = np.where(sets == _KEEP, -2, np.where(name == NAME_ID["probe"], number, -1))
+        last_set = np.where(probe_sets != -2, np.arange(n), -1)
+        np.maximum.accumulate(last_set, out=last_set)
+        probe = np.where(last_set >= 0, probe_sets[np.maximum(last_set, 0)], self.probe)
         if n:
-            self.motion = int(motion[-1])
+            self.motion, self.probe = int(motion[-1]), int(probe[-1])
         motion[lathe] = MOTION_CYCLE
 
         def has(letters: str) -> np.ndarray:
@@ -299,6 +305,9 @@ class GcodeParser:
         has_axes |= arc & has("IJKR")  # "G2 I5" is a full circle from where the tool is
         is_motion_name = np.isin(name, [NAME_ID[m] for m in _MOTION_MODES]) | np.isin(name, self._cycle_ids)
         implicit = (letter == 0) & has_axes if self._modal_motion else np.zeros(n, bool)
+        probing = implicit & (probe >= 0) & (motion == MOTION_LINEAR)
+        name[probing] = NAME_ID["probe"]
+        number[probing] = probe[probing]
         moving = (is_motion_name | implicit) & (has_axes | has_e) | lathe
 
         kind = np.full(n, Kind.CONFIG, np.uint8)
