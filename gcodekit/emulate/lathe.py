@@ -328,12 +328,7 @@ class _Arc(_Segment):
         if isinstance(prev, _Line):  # a line followed by this arc
             if abs(self.start - prev.end) < TOLERANCE:
                 return
-            rot = (prev.start - prev.end).conjugate() / abs(prev.start - prev.end)
-            pe, pc = (self.end - prev.end) * rot, (self.centre - prev.end) * rot
-            b = abs(pc - pe) ** 2 - pc.imag ** 2
-            b = math.sqrt(b) if b >= 0 else 0.0
-            s1, s2 = (pc.real + b) / rot + prev.end, (pc.real - b) / rot + prev.end
-            self.start = prev.end = s1 if abs(self.start - s1) < abs(self.start - s2) else s2
+            self.start = prev.end = _line_meets_circle(prev, self.centre, self.end, self.start)
             return
         a = abs(self.start - self.centre)
         b = abs(prev.start - prev.centre)
@@ -347,12 +342,19 @@ def _line_intersect_arc(line: _Line, arc: _Arc) -> None:
     """An arc followed by ``line``: move the arc's end and the line's start to where they meet."""
     if abs(line.start - arc.end) < TOLERANCE:
         return
+    line.start = arc.end = _line_meets_circle(line, arc.centre, arc.end, line.start)
+
+
+def _line_meets_circle(line: _Line, centre: complex, on_circle: complex, near: complex) -> complex:
+    """Where the line through ``line`` crosses the circle about ``centre``
+    through ``on_circle``: of the two crossings, the one nearer ``near``
+    (a miss gives the foot of the perpendicular from the centre)."""
     rot = (line.start - line.end).conjugate() / abs(line.start - line.end)
-    pe, pc = (arc.end - line.end) * rot, (arc.centre - line.end) * rot
+    pe, pc = (on_circle - line.end) * rot, (centre - line.end) * rot
     b = abs(pc - pe) ** 2 - pc.imag ** 2
     b = math.sqrt(b) if b >= 0 else 0.0
     s1, s2 = (pc.real + b) / rot + line.end, (pc.real - b) / rot + line.end
-    line.start = arc.end = s1 if abs(line.start - s1) < abs(line.start - s2) else s2
+    return s1 if abs(near - s1) < abs(near - s2) else s2
 
 
 class _Fillet(_Arc):
