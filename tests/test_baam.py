@@ -82,3 +82,16 @@ def test_material_event_series_follows_the_screw():
     on = events[events["value"] == 1.0]
     assert len(on) == 8  # the eight perimeter sides, each an event with the screw turning
     assert events["value"].iloc[-1] == 0.0
+
+
+def test_iterating_process_data_derives_the_volumes_once(monkeypatch):
+    # a whole-program column per item made iteration quadratic in the program's length
+    op = gcodekit.gcode_to_operation(WALL, "baam", screw_displacement=2.0)
+    calls = []
+    whole = type(op).deposited_volumes
+    monkeypatch.setattr(type(op), "deposited_volumes", lambda self: calls.append(1) or whole(self))
+    items = list(op.process_data)
+    assert len(calls) == 1
+    expected = whole(op) if op._waypoint_of_command() is None else whole(op)[op._waypoint_of_command()]
+    np.testing.assert_allclose([p.deposited_volume for p in items], expected)
+    assert np.nansum(expected) > 0

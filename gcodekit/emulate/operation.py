@@ -164,7 +164,15 @@ class Operation:
         """Process data of each command; empty before emulation."""
         if self.waypoints is None:
             return []
-        return _LazyList(len(self.table), self._process_data)
+        # one view's columns are derived once, so iterating is linear in the program
+        mapping = self._waypoint_of_command()
+        columns = self._process_columns()
+
+        def make(i: int) -> ProcessData:
+            k = i if mapping is None else int(mapping[i])
+            return self.process_data_class(**self._process_fields(k, columns))
+
+        return _LazyList(len(self.table), make)
 
     @property
     def emulated(self) -> bool:
@@ -185,17 +193,16 @@ class Operation:
         last = np.r_[cmd[1:] != cmd[:-1], True]
         return np.flatnonzero(last)
 
-    def _process_data(self, i: int) -> ProcessData:
-        mapping = self._waypoint_of_command()
-        k = i if mapping is None else int(mapping[i])
-        return self.process_data_class(**self._process_fields(k))
+    def _process_columns(self) -> dict[str, np.ndarray]:
+        """Whole-program columns the process data of one waypoint is read from."""
+        return {"elapsed_time": self.elapsed_time()}
 
-    def _process_fields(self, k: int) -> dict[str, Any]:
+    def _process_fields(self, k: int, columns: dict[str, np.ndarray]) -> dict[str, Any]:
         w = self.waypoints
         return dict(
             location=tuple(float(w[a][k]) for a in "xyzabc"),
             feed_rate=float(w["feed"][k]),
-            elapsed_time=float(self.elapsed_time()[k]),
+            elapsed_time=float(columns["elapsed_time"][k]),
             distance=float(w["distance"][k]),
             duration=float(w["time"][k]),
             motion=MOTION_NAMES[int(w["motion"][k])],
@@ -440,17 +447,15 @@ class AdditiveOperation(Operation):
         area = np.where(set_at >= 0, area_of_row[np.maximum(set_at, 0)], np.nan)
         return area[rows] if n else np.full(len(rows), np.nan)
 
-    def _process_fields(self, k: int) -> dict[str, Any]:
-        fields = super()._process_fields(k)
-        w = self.waypoints
-        kind = self.machine.extruder_type if self.machine else "filament"
-        if kind == "filament":
-            volume = float(w["de"][k]) * self.filament_area
-        else:
-            volume = float(self.deposited_volumes()[k])
+    def _process_columns(self) -> dict[str, np.ndarray]:
+        return {**super()._process_columns(), "deposited_volume": self.deposited_volumes()}
+
+    def _process_fields(self, k: int, columns: dict[str, np.ndarray]) -> dict[str, Any]:
+        fields = super()._process_fields(k, columns)
+        volume = float(columns["deposited_volume"][k])
         distance = fields["distance"]
         fields.update(deposited_volume=volume, bead_area=volume / distance if distance > 0 and volume > 0 else 0.0,
-                      extruder_type=kind)
+                      extruder_type=self.machine.extruder_type if self.machine else "filament")
         return fields
 
 
@@ -459,8 +464,8 @@ class SubtractiveOperation(Operation):
 
     process_data_class = SubtractiveProcessData
 
-    def _process_fields(self, k: int) -> dict[str, Any]:
-        fields = super()._process_fields(k)
+    def _process_fields(self, k: int, columns: dict[str, np.ndarray]) -> dict[str, Any]:
+        fields = super()._process_fields(k, columns)
         fields.update(spindle_speed=float(self.waypoints["spindle"][k]), removed_volume=None)
         return fields
 
