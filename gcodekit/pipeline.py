@@ -27,6 +27,7 @@ from .emulate.machine import Machine
 from .emulate.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine
 from .errors import ConfigError, Diagnostics, GcodeError, check_choice
+from .memory import release_freed_memory
 from .parse import CommandTable, GcodeParser
 from .parse.table import NAME_ID
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
@@ -206,6 +207,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         _check_program_end(program, table, n_lines, diagnostics)
     op = cls(table, _concat_waypoints(waypoints, sizes), file=program.name,
              flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
+    del tables, waypoints
+    release_freed_memory()  # the reader's per-chunk garbage, before the planner's arrays
     from .emulate.compensation import compensate, uses_compensation
 
     if uses_compensation(op):

@@ -127,14 +127,14 @@ def command_rows(op: "Operation", *, names: tuple[str, ...] = (), codes: tuple[s
     return np.flatnonzero(mask)
 
 
-def speed_factor(op: "Operation") -> np.ndarray:
-    """M220 S, as a ratio, in force at each waypoint (1 before any)."""
+def speed_factor(op: "Operation") -> np.ndarray | None:
+    """M220 S, as a ratio, in force at each waypoint (1 before any); None without M220."""
     t = op.table
     rows = command_rows(op, names=("set_speed_factor",))
+    if rows.size == 0:
+        return None
     w = op.waypoints
     cmd = w["command"] if "command" in w else np.arange(len(w["x"]))
-    if rows.size == 0:
-        return np.ones(cmd.size)
     values = t.param("S")[rows] / 100.0
     values = np.where(np.isnan(values), 1.0, values)
     k = np.searchsorted(rows, cmd, side="right") - 1
@@ -206,14 +206,9 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
         changed[1:] |= col[1:] != col[:-1]
     full_circle = (w["motion"] >= 3) & (w["distance"] > 0)  # ends where it started
     idx = np.flatnonzero((w["motion"] > 0) & ~homing & (changed | full_circle))
-    end = np.empty((idx.size, 4))
-    start = np.empty((idx.size, 4))
-    before = idx - 1
-    for k, col in enumerate(columns):
-        end[:, k] = col[idx]
-        start[:, k] = col[np.maximum(before, 0)]
-    if idx.size and idx[0] == 0:
-        start[0] = 0.0
+    del changed
+    start, end = _move_ends(columns, idx)
+    del e, columns
     speed = np.asarray(w["feed"], float)[idx] / 60.0
     if speed_factor is not None:
         speed *= speed_factor[idx]
@@ -221,6 +216,32 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     if arc_segments is None or not is_arc.any():
         return PlannerMoves(start, end, speed, rows[idx], idx)
     return _with_segmented_arcs(w, idx, is_arc, start, end, speed, rows[idx], arc_segments)
+
+
+def _move_ends(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end (X, Y, Z, E) of the moves ending at waypoints ``idx``.
+
+    A move starts where the waypoint before it ended.  When every move
+    starts where the previous move ended (no homing or position jump
+    between them, the usual case) both are views of one array of points,
+    half the memory of two.
+    """
+    before = np.maximum(idx - 1, 0)
+    chained = all(np.array_equal(col[before[1:]], col[idx[:-1]]) for col in columns)
+    if chained:
+        points = np.empty((idx.size + 1, 4))
+        start, end = points[:-1], points[1:]
+    else:
+        start, end = np.empty((idx.size, 4)), np.empty((idx.size, 4))
+    for k, col in enumerate(columns):
+        end[:, k] = col[idx]
+        if not chained:
+            start[:, k] = col[before]
+        elif idx.size:
+            start[0, k] = col[before[0]]
+    if idx.size and idx[0] == 0:
+        start[0] = 0.0
+    return start, end
 
 
 def _with_segmented_arcs(w, idx, is_arc, move_start, move_end, speed, rows, arc_segments) -> PlannerMoves:

@@ -36,7 +36,7 @@ from .scans import backward_min, forward_min
 if TYPE_CHECKING:
     from ..operation import Operation
 
-BLOCK = 1 << 16  # element-wise steps run on this many moves at a time: less fresh memory
+BLOCK = 1 << 14  # element-wise steps run on this many moves at a time: less fresh memory
 MINIMUM_FEED_RATE = 1.0 / 60.0  # grbl config.h: MINIMUM_FEED_RATE 1.0 mm/min
 MINIMUM_JUNCTION_SPEED = 0.0  # grbl config.h, mm/s
 COS_STRAIGHT = 0.999999  # planner.c: |junction_cos_theta| beyond this is a reversal or a straight line

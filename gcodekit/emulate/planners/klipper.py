@@ -192,7 +192,7 @@ def _velocity_limits(op: "Operation", config: KlipperConfig):
 
 #: Moves handled at once by the element-wise steps: small blocks reuse
 #: memory instead of touching fresh pages for every temporary array.
-BLOCK = 1 << 16
+BLOCK = 1 << 14
 
 
 def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResult]:
@@ -361,19 +361,29 @@ def _cruise(start_v2, mcr_start_v2, m, flush):
 
 
 def _set_junction(start_v2, cruise_v2, next_start_v2, m) -> PlanResult:
-    """Move.set_junction: the trapezoid of each move."""
+    """Move.set_junction: the trapezoid of each move (in blocks: fewer temporaries at once)."""
+    n = start_v2.size
+    result = PlanResult(np.empty(n), np.empty(n), np.empty(n), m["accel"], np.empty(n), np.empty(n), np.empty(n))
+    for lo in range(0, n, BLOCK):
+        sl = slice(lo, min(lo + BLOCK, n))
+        _set_junction_block(start_v2[sl], cruise_v2[sl], next_start_v2[sl], m["accel"][sl], m["move_d"][sl],
+                            result, sl)
+    return result
+
+
+def _set_junction_block(start_v2, cruise_v2, next_start_v2, accel, move_d, result: PlanResult, sl: slice) -> None:
     start_v2 = np.minimum(start_v2, cruise_v2)
     end_v2 = np.minimum(next_start_v2, cruise_v2)
-    half_inv_accel = 0.5 / m["accel"]
+    half_inv_accel = 0.5 / accel
     accel_d = (cruise_v2 - start_v2) * half_inv_accel
     decel_d = (cruise_v2 - end_v2) * half_inv_accel
-    cruise_d = m["move_d"] - accel_d - decel_d
+    cruise_d = move_d - accel_d - decel_d
     start_v, cruise_v, end_v = np.sqrt(start_v2), np.sqrt(cruise_v2), np.sqrt(end_v2)
     with np.errstate(divide="ignore", invalid="ignore"):
-        accel_t = np.where(accel_d > 0, accel_d / ((start_v + cruise_v) * 0.5), 0.0)
-        cruise_t = np.where(cruise_d != 0, cruise_d / cruise_v, 0.0)
-        decel_t = np.where(decel_d > 0, decel_d / ((end_v + cruise_v) * 0.5), 0.0)
-    return PlanResult(start_v, cruise_v, end_v, m["accel"], accel_t, cruise_t, decel_t)
+        result.accel_t[sl] = np.where(accel_d > 0, accel_d / ((start_v + cruise_v) * 0.5), 0.0)
+        result.cruise_t[sl] = np.where(cruise_d != 0, cruise_d / cruise_v, 0.0)
+        result.decel_t[sl] = np.where(decel_d > 0, decel_d / ((end_v + cruise_v) * 0.5), 0.0)
+    result.start_v[sl], result.cruise_v[sl], result.end_v[sl] = start_v, cruise_v, end_v
 
 
 def _minimum(first: np.ndarray, *others: np.ndarray) -> np.ndarray:
