@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import ConfigError
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
+from .base import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
 
 if TYPE_CHECKING:
@@ -195,7 +195,7 @@ def _velocity_limits(op: "Operation", config: KlipperConfig):
 BLOCK = 1 << 14
 
 
-def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResult]:
+def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult]:
     """Plan an emulated operation as Klipper would; one result per firmware move."""
     factor = speed_factor(op)
     # gcode_arcs.py: chords of at most `resolution` mm
@@ -218,16 +218,19 @@ def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves, PlanResu
     for lo in range(0, n, BLOCK):
         hi = min(lo + BLOCK, n)
         _move_block(moves, rows, limits, config, flush, lo, hi, m, junction)
+    planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, m["move_d"])
+    del moves  # the end points are no longer needed: free them before the passes
 
     # max_start_v2 = min(cap, prev.max_start_v2 + prev.delta_v2): forward scans
-    max_start_v2 = forward_min(m["cap"], m["delta_v2"])
+    max_start_v2 = forward_min(m.pop("cap"), m["delta_v2"])
     max_mcr_start_v2 = forward_min(np.where(junction, max_start_v2, 0.0), m["mcr_delta_v2"])
     # LookAheadQueue.flush, backward: assume a stop after the last move of each flush
     start_v2 = backward_min(max_start_v2, m["delta_v2"])
     mcr_start_v2 = backward_min(max_mcr_start_v2, m["mcr_delta_v2"])
     del max_start_v2, max_mcr_start_v2
     cruise_v2, next_start_v2 = _cruise(start_v2, mcr_start_v2, m, flush)
-    return moves, _set_junction(start_v2, cruise_v2, next_start_v2, m)
+    del mcr_start_v2, m["max_cruise_v2"], m["delta_v2"], m["mcr_delta_v2"]  # free before the trapezoids
+    return planned, _set_junction(start_v2, cruise_v2, next_start_v2, m)
 
 
 def _move_block(moves, rows, limits, config, flush, lo, hi, m, junction) -> None:
