@@ -26,6 +26,7 @@ import numpy as np
 from .emulate.machine import Machine
 from .emulate.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine
+from .emulate.state_parameters import is_state_parameter, machine_parameter
 from .errors import ConfigError, Diagnostics, GcodeError, check_choice
 from .memory import release_freed_memory
 from .parse import CommandTable, GcodeParser
@@ -237,7 +238,8 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
     With ``machine`` (the machine and a function that parses and emulates
     blocks), a program that probes is emulated up to its latest probe move
     whenever a line reads or writes the probe results (#5061-#5070), so they
-    hold that probe's results (see :class:`_ProbeResults`).
+    hold that probe's results, and state parameters (``#5420``, ``#<_x>``)
+    read the machine (see :class:`_MachineFeedback`).
     """
     if flavor.parameters or flavor.wizards:
         from .preprocess import ControlFlowStage, ParameterStore, SourceLine, needs_parameters, run_stages
@@ -246,12 +248,12 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
         # probes and reads of their results may sit in subroutine files: watch every program
         # (until a probe goes by, the watch only collects the lines)
-        feedback = _ProbeResults(flavor, diagnostics, *machine) if machine is not None else None
+        feedback = _MachineFeedback(flavor, diagnostics, *machine) if machine is not None else None
         store = ParameterStore(system=feedback.system) if feedback is not None else None
         stages = [ControlFlowStage(flavor, store)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text)) else []
         if not stages:
-            feedback = None  # no parameters to bring probe results to
+            feedback = None  # no parameters for the machine to give
         stages += [WizardStage(flavor)] if flavor.wizards and needs_wizards(text) else []
         if stages:
             program.preprocessed = True
@@ -291,19 +293,26 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         yield blocks, sizes[-1]
 
 
-class _ProbeResults:
-    """LinuxCNC's probe results (#5061-#5070) for the parameter stage, from the machine.
+class _MachineFeedback:
+    """Parameters the machine gives the parameter stage: probe results and the machine's state.
 
-    rs274 sets them when it reads the block after a probe move
-    (``set_probe_data``): #5061-#5066 the X Y Z A B C where the probe
-    tripped, in program coordinates, #5067-#5069 U V W (0 here) and #5070 1
-    when it tripped.  Run standalone it has no probe input: every probe
-    "trips" at its target and #5070 is 0 (saicanon.cc), and so does
-    gcodekit (see ``Machine._after_probe``).  The lines the stages pass on
-    are held back and emulated as soon as a line after a probe touches one
-    of these parameters, then the results of the last probe emulated since
-    the previous time are written to the store (axis words alone after a
-    G38.x probe again, so any held line may have probed).
+    The lines the stages pass on are held back and emulated as soon as a
+    line needs the machine: then every line before it has run, as in
+    rs274, which runs a block before it reads the next.
+
+    * State parameters (``#5420``, ``#<_x>``, ``#<_imperial>``, ... when the
+      flavor has them, see :mod:`gcodekit.emulate.state_parameters`) are
+      read from the machine.
+    * Probe results (#5061-#5070): rs274 sets them when it reads the block
+      after a probe move (``set_probe_data``): #5061-#5066 the X Y Z A B C
+      where the probe tripped, in program coordinates, #5067-#5069 U V W
+      (0 here) and #5070 1 when it tripped.  Run standalone it has no probe
+      input: every probe "trips" at its target and #5070 is 0
+      (saicanon.cc), and so does gcodekit (see ``Machine._after_probe``).
+      When a line after a probe touches one of them, the results of the
+      last probe emulated since the previous time are written to the store
+      (axis words alone after a G38.x probe again, so any held line may
+      have probed); they stay ordinary, writable parameters.
     """
 
     def __init__(self, flavor: Flavor, diagnostics: Diagnostics, machine: Machine,
@@ -313,6 +322,7 @@ class _ProbeResults:
         self.probed = False  # a probe line went by: held lines may probe
         self.applied = 0  # probes whose results went to the store
         self.store = None
+        self.state_parameters = flavor.state_parameters == "linuxcnc"
 
     def watch(self, lines: Iterator, store) -> Iterator:
         """Pass ``lines`` on, noting probe moves; yields only the lines left at the end."""
@@ -324,21 +334,34 @@ class _ProbeResults:
         yield from self.held
 
     def system(self, key: int | str) -> float | None:
-        """The store's system-parameter hook: brings probe results in before #5061-#5070 are used."""
-        if self.probed and self.held and key in _PROBE_RESULTS:
-            held, self.held = self.held, []
-            try:
-                self.emulate(read_source_lines(held, self.flavor, self.diagnostics), 0)
-            except GcodeError as exc:  # strict mode: the machine's error, not the parameter stage's
-                raise _MachineStop(exc) from None
-            result = self.machine.probe_result
-            if self.machine.probes > self.applied:
-                self.applied = self.machine.probes
-                for number, value in zip(range(5061, 5067), result):
-                    self.store.set(number, float(value))
-                for number in (5067, 5068, 5069, 5070):  # no U V W axes; never tripped
-                    self.store.set(number, 0.0)
-        return None  # they stay ordinary, writable parameters
+        """The store's system-parameter hook: the machine's value of ``key``, or None."""
+        if key in _PROBE_RESULTS:
+            if self.probed and self.held:
+                self._catch_up()
+                self._store_probe_results()
+            return None
+        if self.state_parameters and is_state_parameter(key):
+            self._catch_up()
+            return machine_parameter(self.machine, key)
+        return None
+
+    def _catch_up(self) -> None:
+        """Emulate the held lines."""
+        if not self.held:
+            return
+        held, self.held = self.held, []
+        try:
+            self.emulate(read_source_lines(held, self.flavor, self.diagnostics), 0)
+        except GcodeError as exc:  # strict mode: the machine's error, not the parameter stage's
+            raise _MachineStop(exc) from None
+
+    def _store_probe_results(self) -> None:
+        if self.machine.probes > self.applied:
+            self.applied = self.machine.probes
+            for number, value in zip(range(5061, 5067), self.machine.probe_result):
+                self.store.set(number, float(value))
+            for number in (5067, 5068, 5069, 5070):  # no U V W axes; never tripped
+                self.store.set(number, 0.0)
 
 
 class _MachineStop(Exception):

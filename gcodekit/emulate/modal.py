@@ -460,7 +460,8 @@ class ModalHandler:
                 s.tool = number
             s.selected_tool = number
         else:
-            s.tool = int(params.get("T", s.selected_tool))
+            s.selected_tool = int(params.get("T", s.selected_tool))  # ``T1 M6``: the T selects too
+            s.tool = s.selected_tool
 
     def _set_kinematic_position(self, text: str) -> None:
         """Klipper's SET_KINEMATIC_POSITION X=.. Y=.. Z=..: the toolhead is declared there."""

@@ -158,6 +158,10 @@ class Flavor:
     directive_prefix : str
         Lines starting with this text are controller directives kept as
         named commands (Beckhoff ``#TRAFO ON``); ``""`` for none.
+    state_parameters : {"", "linuxcnc"}
+        Parameters a program reads the machine's state from: ``"linuxcnc"``
+        for ``#5420``-``#5428``, ``#<_x>``, ``#<_imperial>``, ... (see
+        :mod:`gcodekit.emulate.state_parameters`); ``""`` for none.
 
     Attributes (semantics)
     ----------------------
@@ -203,6 +207,7 @@ class Flavor:
     code_assignments: bool = False
     assignments: bool = False
     directive_prefix: str = ""
+    state_parameters: str = ""
     polar_words: bool = False
     polar_incremental_only: bool = False
     required_axes: str = ""

@@ -1,0 +1,57 @@
+"""LinuxCNC state parameters (#5420, #<_x>, #<_imperial>, ...) read the emulated machine.
+
+rs274's own output for most of them is the golden case
+``golden/linuxcnc/own/state_parameters.ngc``; these tests cover what that
+case cannot: values worked out by hand on a metric machine, and errors.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import gcodekit
+
+
+def run(text: str, **options):
+    return gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, **options)
+
+
+def moves(op, axis: str = "x") -> list[float]:
+    w = op.waypoints
+    return w[axis][w["motion"] > 0].tolist()
+
+
+def test_position_is_read_after_the_lines_before_it_ran():
+    # G92 shifts the program origin: #5420 is the program position, not the machine's
+    op = run("G21 G0 X10 Y4\nG92 X0\nG1 X[#5420+2] Y[#<_y>/2] F100\nG0 X[#<_x>*3]\nM2\n")
+    np.testing.assert_allclose(moves(op), [10.0, 12.0, 16.0])  # program 2, then 6, plus the 10 of G92
+    assert moves(op, "y") == [4.0, 2.0, 2.0]
+
+
+def test_inch_program_reads_inches():
+    # the line is read before its G21 runs: X1.5 there is 1.5 mm, as in rs274
+    op = run("G20 G0 X1\nG0 X[#<_x>+0.5]\nG21 G0 X[#<_x>]\nM2\n")
+    np.testing.assert_allclose(moves(op), [25.4, 38.1, 1.5])
+
+
+def test_tool_offsets_are_in_machine_units(tmp_path):
+    table = tmp_path / "tools.tbl"
+    table.write_text("T1 P1 Z12.5 D6 ;\n")
+    op = run("G21 T1 M6 G43\nG0 X[#5403]\nM2\n", tool_table=table)
+    assert moves(op) == pytest.approx([12.5])
+    inch = run("G21 T1 M6 G43\nG0 X[#5403]\nM2\n", tool_table=table, tool_table_units="inch")
+    assert moves(inch) == pytest.approx([12.5])  # the table's number, as rs274 gives it
+
+
+@pytest.mark.parametrize("line", ["#<_x> = 5", "#5420 = 3"])
+def test_writing_one_is_an_error_on_its_line(line):
+    op = run(f"G0 X1\n{line}\nM2\n")
+    errors = [d for d in op.diagnostics.items if d.severity == "error"]
+    assert [(d.line, "read-only" in d.message) for d in errors] == [(2, True)]
+
+
+def test_other_dialects_keep_ordinary_parameters():
+    # Fanuc macro programs use #5001.. for positions; #5420 is just a variable there
+    op = gcodekit.gcode_to_operation("G21 G0 X10\n#5420 = 3\nG0 X[#5420]\nM30\n", "fanuc", plan=False)
+    assert moves(op) == [10.0, 3.0]
