@@ -11,7 +11,8 @@ or ``order`` for moves rs274 emitted late), no rotary-axis work or G92 offset is
 only carries X/Y/Z offsets), its text (comments stripped) uses no feature
 gcodekit does not emulate yet (:data:`EXCLUDED_G`: G33.1,
 G76; I/O M-codes, user or unknown
-codes, system parameters other than the probe results #5061-#5070), and it is
+codes, system parameters other than the probe results #5061-#5070 and the
+machine-state ones of :mod:`gcodekit.emulate.state_parameters`), and it is
 not a :data:`KNOWN_GAPS` program; the subroutine files it calls by name and
 rs274 found beside it are scanned too and copied with it.
 
@@ -38,6 +39,8 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from gcodekit.emulate.state_parameters import is_state_parameter
+
 HERE = Path(__file__).resolve().parent
 CASES = HERE / "cases"
 OWN = HERE / "own"  # programs we wrote for what the corpus lacks, with rs274's output
@@ -54,8 +57,7 @@ ANGLED = re.compile(r"<[^>]*>")
 LETTER_RUN = re.compile(r"[A-Z]{2,}")  # functions, operators and O-word keywords
 CODE = re.compile(r"(?<![A-Z])([GM])(\d+(?:\.\d+)?)")
 COMPUTED_CODE = re.compile(r"(?<![A-Z])[GM][\[#]")
-LATHE_CYCLE = re.compile(r"(?<![A-Z])G0*7[012](?:\.[12])?(?![0-9.])")
-SYSTEM_NUMBERED = re.compile(r"#5(?!06[1-9]|070)\d{3}(?!\d)")  # probe results #5061-#5070 are emulated
+SYSTEM_NUMBERED = re.compile(r"#(5\d{3})(?!\d)")
 CALL = re.compile(r"o\s*<\s*([^>]*?)\s*>\s*call", re.I)  # a subroutine called by name
 
 #: Predefined (read-only) named parameters of LinuxCNC 2.9.
@@ -116,15 +118,14 @@ def scan_text(text: str) -> tuple[list[str], list[str]]:
     reasons: dict[str, None] = {}
     body = "\n".join(COMMENT.sub("", line) for line in text.upper().splitlines())
     body = re.sub(r"[ \t\r]", "", body)
-    # gcodekit gives #<_x>/#<_z> only while a lathe cycle reads its profile
-    profile_point = {"_x", "_z"} if LATHE_CYCLE.search(body) else set()
     for name in NAMED.findall(body):
         key = name.lower()
-        if (key in SYSTEM_NAMED and key not in profile_point) or key.startswith(("_ini[", "_hal[")):
+        if (key in SYSTEM_NAMED and not is_state_parameter(key)) or key.startswith(("_ini[", "_hal[")):
             reasons[f"system parameter #<{key}>"] = None
     body = ANGLED.sub("<>", body)
     body = LETTER_RUN.sub(" ", body)
-    if SYSTEM_NUMBERED.search(body):
+    # probe results #5061-#5070 and the machine's state are emulated
+    if any(not (5061 <= int(k) <= 5070 or is_state_parameter(int(k))) for k in SYSTEM_NUMBERED.findall(body)):
         reasons["system parameter #5xxx"] = None
     if COMPUTED_CODE.search(body):
         reasons["computed G/M code"] = None
