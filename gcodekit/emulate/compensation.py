@@ -11,6 +11,11 @@ tool off it by the tool radius, after the rules of LinuxCNC's interpreter
   by the tool radius); at an outside corner the tool rolls round the
   programmed corner on an arc of the tool radius, at an inside corner the
   previous move is cut short where the two shifted paths meet;
+* a corner turning less than 0.05 rad (rs274's ``TOLERANCE_CONCAVE_CORNER``)
+  either way gets neither: the move starts where the tool is; a rapid
+  round an outside corner goes straight to where the roll would end (there
+  is no rapid arc); moves with no motion in the plane in between are cut
+  short with the move before them;
 * the first move after G40 (the exit) runs straight to its programmed end;
 * a lathe tool (orientation 1-8, the tool table's Q or G41.1/G42.1's L) in
   the XZ plane (G18) is compensated about its nose centre and then moved by
@@ -33,7 +38,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, NAME_ID
+from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, MOTION_RAPID, NAME_ID
 from .arcs import PLANES, arc_length, sweep
 
 if TYPE_CHECKING:
@@ -43,6 +48,8 @@ _SIDES = {NAME_ID["cutter_comp_left"]: 1, NAME_ID["cutter_comp_right"]: -1, NAME
           NAME_ID["cutter_comp_left_dynamic"]: 1, NAME_ID["cutter_comp_right_dynamic"]: -1}
 _DYNAMIC = {NAME_ID["cutter_comp_left_dynamic"], NAME_ID["cutter_comp_right_dynamic"]}  # G41.1/G42.1: D is a diameter
 _TINY = 1e-9
+#: rs274's TOLERANCE_CONCAVE_CORNER (radians): a corner turning less than this is taken as straight on
+CONCAVE_CORNER = 0.05
 
 
 def uses_compensation(op: "Operation") -> bool:
@@ -66,6 +73,7 @@ def compensate(op: "Operation", tools) -> None:
     last_path = None  # its offset path: ("line", point, direction) or ("arc", centre, radius)
     last_corner = None  # programmed end of the previous move
     pending = None  # index in `out` of the previous compensated waypoint
+    staying: list[int] = []  # later rows that end where `pending` does (no move in the plane)
     pending_start, pending_dir = None, None  # where it starts and, for a line, its programmed direction
     side_rows = {int(r): _SIDES[int(t.name[r])] for r in np.flatnonzero(np.isin(t.name, list(_SIDES)))}
     tool_changes = set(np.flatnonzero(t.name == NAME_ID["tool_change"]).tolist())
@@ -142,7 +150,9 @@ def compensate(op: "Operation", tools) -> None:
             op.diagnostics.report(int(t.line[row]), 1, "Length of cutter compensation entry move is not "
                                   "greater than the tool radius", kind="machine")
         if np.hypot(*chord) < _TINY and motion < MOTION_CW:  # a move along the plane's normal keeps the offset
-            emit(k, **{a: start[0], b: start[1]})
+            row_out = emit(k, **{a: start[0], b: start[1]})
+            if pending is not None:
+                staying.append(row_out)  # an inside corner moves it with `pending` (move_endpoint_and_flush)
             continue
         if motion in (MOTION_CW, MOTION_CCW):
             center = np.array([columns[ca][k], columns[cb][k]])
@@ -180,7 +190,7 @@ def compensate(op: "Operation", tools) -> None:
                 emit(k, **{a: start[0], b: start[1], h: out[h][-1] if out["x"] else 0.0, "motion": MOTION_LINEAR,
                            "cx": np.nan, "cy": np.nan, "cz": np.nan, "distance": length, "de": 0.0,
                            "time": length / (feed / 60.0) if feed > 0 else 0.0})
-            pending = emit(k, **{a: new_end[0], b: new_end[1], ca: entry_center[0], cb: entry_center[1]})
+            pending, staying = emit(k, **{a: new_end[0], b: new_end[1], ca: entry_center[0], cb: entry_center[1]}), []
             pending_start, pending_dir = start, None
             mode, last_dir, last_corner = "on", out_dir, end
             last_path = ("arc", entry_center, float(np.hypot(*(new_end - entry_center))))
@@ -189,16 +199,22 @@ def compensate(op: "Operation", tools) -> None:
             # comp1: straight to the end shifted off the entry move's own direction
             shifted = end + _left(_unit(chord)) * side * radius
             moved = lathe
-            pending = emit(k, **{a: shifted[0], b: shifted[1]})
+            pending, staying = emit(k, **{a: shifted[0], b: shifted[1]}), []
             pending_start, pending_dir = start, _unit(chord)
             mode, last_dir, last_corner = "on", _unit(chord), end
             last_path = ("line", shifted, _unit(chord))
             continue
-        turn = last_dir[0] * in_dir[1] - last_dir[1] * in_dir[0]
+        # beta: how far the path turns away from the tool's side (> 0: an outside corner)
+        beta = -side * math.atan2(last_dir[0] * in_dir[1] - last_dir[1] * in_dir[0], float(last_dir @ in_dir))
         this_path = ("arc", center, new_r1) if motion in (MOTION_CW, MOTION_CCW) else ("line", new_start, in_dir)
         gap = np.hypot(*(new_start - start))
-        if gap > _TINY:
-            if turn * side < 0:  # outside corner: roll round the programmed corner
+        # within CONCAVE_CORNER of straight on, rs274 neither rolls round nor trims: the
+        # move starts where the tool is
+        if gap > _TINY and abs(beta) > CONCAVE_CORNER:
+            if beta > 0 and motion == MOTION_RAPID:
+                # no rapid arc: rs274 traverses straight to where the roll would end
+                emit(k, **{a: new_start[0], b: new_start[1]}, distance=float(gap), de=0.0)
+            elif beta > 0:  # outside corner: roll round the programmed corner
                 length = radius * _angle(start, new_start, programmed_start)
                 feed = float(columns["feed"][k])
                 emit(k, **{a: new_start[0], b: new_start[1], ca: programmed_start[0], cb: programmed_start[1]},
@@ -208,7 +224,8 @@ def compensate(op: "Operation", tools) -> None:
                 # inside corner: cut the previous move where the two offset paths meet
                 meet = _crossing(last_path, this_path, new_start)
                 if meet is not None:
-                    out[a][pending], out[b][pending] = meet[0], meet[1]
+                    for r in (pending, *staying):
+                        out[a][r], out[b][r] = meet[0], meet[1]
                     new_start = meet
                 else:
                     kinds = "Arc" if last_path[0] == "arc" else "Straight", "arc" if this_path[0] == "arc" else "straight"
@@ -220,7 +237,7 @@ def compensate(op: "Operation", tools) -> None:
                 op.diagnostics.report(int(t.line[row]), 1, "Straight feed in concave corner cannot be reached by "
                                       "the tool without gouging", kind="machine")
         centre = (columns[ca][k], columns[cb][k]) if motion in (MOTION_CW, MOTION_CCW) else (np.nan, np.nan)
-        pending = emit(k, **{a: new_end[0], b: new_end[1], ca: centre[0], cb: centre[1]})
+        pending, staying = emit(k, **{a: new_end[0], b: new_end[1], ca: centre[0], cb: centre[1]}), []
         pending_start, pending_dir = new_start, (None if motion in (MOTION_CW, MOTION_CCW) else in_dir)
         last_dir, last_corner, last_path = out_dir, end, this_path
     for i, da, db, plane in lathe_rows:

@@ -74,8 +74,8 @@ _value _value_returned _task _call_level _remap_level
 
 #: Programs gcodekit knows it does not reproduce yet, and why.
 KNOWN_GAPS = {
-    "nc_files/lathe_g70_71_demo.ngc": "its G70 runs under G42.1: XZ-plane compensation of the finishing pass differs "
-                                      "(the G71.1/G71.2 roughing, motions 1-191, matches)",
+    "nc_files/lathe_g70_71_demo.ngc": "2 of 244 motions differ: the two rapids entering its G70 under G42.1 "
+                                      "(rs274's G70 reads its Q profile into the block it then moves with)",
 }
 
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
