@@ -42,6 +42,28 @@ def test_g42_outside_a_square_rolls_round_corners(tool_table):
     np.testing.assert_allclose(arcs[["cx", "cy"]].to_numpy(), [[10, 0], [10, 10]], atol=1e-12)
 
 
+def test_rapids_round_an_outside_corner_go_straight(tool_table):
+    # no rapid arc: straight from (10, -1) to (11, 0), sqrt(2) mm at the 3000 mm/min rapid rate
+    op = gcodekit.gcode_to_operation("G21 G17 G90 T1 M6\nG0 X-5 Y0\nG42 G0 X0 Y0\nX10\nY10\nG40 X-5\n", "linuxcnc",
+                                     plan=False, tool_table=tool_table, tool_table_units="mm")
+    m = op.motions()
+    assert m["motion"].tolist() == ["rapid"] * 6
+    np.testing.assert_allclose(m[["x", "y"]].to_numpy()[2:4], [(10, -1), (11, 0)], atol=1e-12)
+    w = op.waypoints
+    moved = w["motion"] > 0
+    assert w["distance"][moved][3] == pytest.approx(math.sqrt(2))
+    assert w["time"][moved][3] == pytest.approx(math.sqrt(2) / 3000 * 60)
+
+
+def test_corners_within_rs274s_tolerance_are_taken_straight_on(tool_table):
+    # 0.02 rad is under TOLERANCE_CONCAVE_CORNER (0.05): no roll arc, the next move starts where the tool is
+    m = motions("G21 G17 G90 T1 M6\nG0 X-5 Y0\nG42 G1 X0 Y0 F600\nX10\nX20 Y-0.2\nG40 X30\n", tool_table)
+    assert m["motion"].tolist() == ["rapid", "feed", "feed", "feed", "feed"]
+    slope = math.atan2(-0.2, 10)
+    np.testing.assert_allclose(m[["x", "y"]].to_numpy()[3], (20 - math.sin(-slope), -0.2 - math.cos(slope)),
+                               atol=1e-12)
+
+
 def test_g41_inside_corner_is_cut_short(tool_table):
     m = motions("G21 G17 G90 T1 M6\nG0 X0 Y-5\nG41 G1 X0 Y0 F600\nX10\nY10\n", tool_table)
     expected = [

@@ -213,7 +213,9 @@ def compensate(op: "Operation", tools) -> None:
         if gap > _TINY and abs(beta) > CONCAVE_CORNER:
             if beta > 0 and motion == MOTION_RAPID:
                 # no rapid arc: rs274 traverses straight to where the roll would end
-                emit(k, **{a: new_start[0], b: new_start[1]}, distance=float(gap), de=0.0)
+                whole = float(columns["distance"][k])  # at the rapid's own speed
+                emit(k, **{a: new_start[0], b: new_start[1]}, distance=float(gap), de=0.0,
+                     time=float(columns["time"][k]) * gap / whole if whole > 0 else 0.0)
             elif beta > 0:  # outside corner: roll round the programmed corner
                 length = radius * _angle(start, new_start, programmed_start)
                 feed = float(columns["feed"][k])
