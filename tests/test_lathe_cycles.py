@@ -78,3 +78,13 @@ def test_plane_must_be_xz() -> None:
     op = gcodekit.gcode_to_operation(program, machine="linuxcnc", plan=False)
     errors = [d for d in op.diagnostics if d.severity == "error"]
     assert errors[0].message == "G71.0 can only be used in XZ plane (G18)" and errors[0].line == 8
+
+
+@pytest.mark.parametrize("cycle, refused", [("G71", True), ("G72", True), ("G70", False)])
+def test_only_g70_runs_under_compensation(cycle: str, refused: bool) -> None:
+    """rs274: "G71.0 cannot be used with cutter compensation enabled", on the cycle's line; G70 may run."""
+    program = PROFILE.replace("G0 X6 Z1", "G0 X6 Z1\nG42.1 D0.4 L2").format(cycle=f"{cycle} Q100 X6 Z1 D0.2 I0.5")
+    op = gcodekit.gcode_to_operation(program, machine="linuxcnc", plan=False)
+    errors = [(d.line, d.message) for d in op.diagnostics if d.severity == "error"]
+    refusal = (9, f"{cycle}.0 cannot be used with cutter compensation enabled")
+    assert (refusal in errors) == refused

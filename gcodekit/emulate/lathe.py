@@ -657,6 +657,7 @@ class CycleBlock:
     arc_incremental: bool
     diameter: bool
     plane: int
+    compensating: bool = False  # cutter compensation on: only G70 may run
 
 
 def profile_of(comment: str | None) -> str | None:
@@ -681,6 +682,8 @@ def run_lathe_cycle(block: CycleBlock) -> tuple[complex, list[Move]]:
         raise LatheCycleError("G7x.x  requires a Q word")
     if block.plane != 18:
         raise LatheCycleError(f"{label} can only be used in XZ plane (G18)")
+    if block.compensating and cycle != 70:
+        raise LatheCycleError(f"{label} cannot be used with cutter compensation enabled")
     if block.profile is None:
         raise LatheCycleError(f"G7x profile o{int(p['Q'])} was not read (its subroutine is missing)")
     k = block.scale

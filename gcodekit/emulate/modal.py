@@ -36,7 +36,8 @@ SPECIAL_NAMES = frozenset(
     coolant_mist coolant_flood coolant_off program_end machine_coordinates
     firmware_retract firmware_unretract set_kinematic_position
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
-    coordinate_data local_offset retract_initial retract_r laser_on laser_off deposition_switch set_bead polar_on polar_off diameter_mode radius_mode""".split()
+    coordinate_data local_offset retract_initial retract_r laser_on laser_off deposition_switch set_bead polar_on polar_off diameter_mode radius_mode
+    cutter_comp_off cutter_comp_left cutter_comp_right cutter_comp_left_dynamic cutter_comp_right_dynamic""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)} | SPLINE_NAMES
 
 _MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
@@ -180,6 +181,8 @@ class ModalHandler:
                 s.laser = 0
         elif name in ("coolant_mist", "coolant_flood", "coolant_off"):
             s.coolant = {"coolant_mist": s.coolant | 1, "coolant_flood": s.coolant | 2, "coolant_off": 0}[name]
+        elif name.startswith("cutter_comp_"):
+            s.compensating = name != "cutter_comp_off"
         elif name == "program_end":
             self._end_program()
         elif name in ("tool_length_offset", "tool_length_offset_add"):
@@ -254,7 +257,7 @@ class ModalHandler:
         s = self.state
         program = s.program_position()
         block = CycleBlock(name, params, profile_of(comment), complex(program[2], program[0]), s.units,
-                           s.incremental, s.arc_incremental, s.diameter, s.plane)
+                           s.incremental, s.arc_incremental, s.diameter, s.plane, s.compensating)
         try:
             point, moves = run_lathe_cycle(block)
         except LatheCycleError as exc:
@@ -490,7 +493,7 @@ class ModalHandler:
         """M2/M30: LinuxCNC resets these modes and stops reading the program."""
         s = self.state
         s.work_offset, s.plane, s.incremental, s.feed_mode = 1, 17, False, "per_minute"
-        s.spindle, s.coolant = 0, 0
+        s.spindle, s.coolant, s.compensating = 0, 0, False
         s.ended = True
 
     # -- output -------------------------------------------------------------------

@@ -58,6 +58,7 @@ class MachineState:
     coolant: int = 0  # bit 1 mist, bit 2 flood
     laser: int = 0  # heat source (DED laser or weld arc) on
     retracted: bool = False  # firmware retraction (G10) in effect
+    compensating: bool = False  # G41/G42 in force (the path is offset by a later pass)
     cycle: CycleState = field(default_factory=CycleState)  # canned-cycle words in force
     ended: bool = False  # M2/M30 reached: later blocks are not run
 
