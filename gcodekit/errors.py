@@ -97,6 +97,8 @@ class Diagnostics:
         self.limit = limit
         self.items: list[Diagnostic] = []
         self.dropped = 0
+        #: Line numbers standing for lines of other files (subroutine files): number -> (file, line)
+        self.elsewhere: dict[int, tuple[str, int]] = {}
         self._first_error: tuple[str, Diagnostic] | None = None  # (kind, diagnostic), for raise_first
 
     def report(
@@ -108,9 +110,17 @@ class Diagnostics:
         *,
         severity: Severity = "error",
         kind: str = "syntax",
+        file: str | None = None,
     ) -> Diagnostic:
-        """Record a diagnostic; in strict mode an error is raised instead."""
-        diag = Diagnostic(self.file, int(line), int(column), severity, message, text)
+        """Record a diagnostic; in strict mode an error is raised instead.
+
+        ``file`` defaults to the program's; a line number of :attr:`elsewhere`
+        names its own file and line.
+        """
+        line = int(line)
+        if file is None:
+            file, line = self.elsewhere.get(line, (self.file, line))
+        diag = Diagnostic(file, line, int(column), severity, message, text)
         if self.mode == "strict" and severity == "error":
             raise _ERROR_TYPES[kind](message, diag)
         if severity == "error" and self._first_error is None:

@@ -42,6 +42,8 @@ __all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "em
 _O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
 _PROBE_LINE = re.compile(r"(?i)g\s*0*3\s*8\s*\.\s*[2-5]")  # G38.2 .. G38.5 in a preprocessed line
 _PROBE_RESULTS = range(5061, 5071)
+#: Line numbers from here up stand for lines of subroutine files (see _number_other_files)
+ELSEWHERE_LINES = 1 << 30
 _PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
 
 
@@ -117,8 +119,9 @@ def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None,
         parts.append(parser.parse(blocks))
         n_lines += lines
     cls = OPERATION_CLASSES[config.process]
-    return cls(CommandTable.concat(parts) if parts else _empty_table(parser, program),
-               file=program.name, flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
+    table = CommandTable.concat(parts) if parts else _empty_table(parser, program)
+    _restore_line_numbers(table, diagnostics)
+    return cls(table, file=program.name, flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
 
 
 def emulate_operation(operation: Operation, machine: str | MachineConfig | None = None) -> Operation:
@@ -218,6 +221,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         from .emulate.planners import planner_settings, run_planner
 
         run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
+    _restore_line_numbers(op.table, diagnostics)
     quote_diagnostics(op.diagnostics, program)
     return op
 
@@ -266,13 +270,14 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
                 # preprocess error, in execution order, may fail first.
                 early = Diagnostics(diagnostics.file, "lenient")
                 out = _until_first_error(run_stages(source, stages, early), early)
+                out = _number_other_files(out, program.name, diagnostics)
                 if feedback is not None:
                     out = feedback.watch(out, store)
                 yield _MachineStop.read(out, flavor, diagnostics), len(lines)
                 diagnostics.extend(d for d in early if d.severity != "error")
                 early.raise_first()
                 return
-            out = run_stages(source, stages, diagnostics)
+            out = _number_other_files(run_stages(source, stages, diagnostics), program.name, diagnostics)
             if feedback is not None:
                 out = feedback.watch(out, store)
             yield _MachineStop.read(out, flavor, diagnostics), len(lines)
@@ -291,6 +296,37 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
 
     for blocks in iter_blocks(counted(), flavor, diagnostics):
         yield blocks, sizes[-1]
+
+
+def _number_other_files(lines: Iterator, main: str, diagnostics: Diagnostics) -> Iterator:
+    """Lines of other files (subroutine files) under numbers of their own.
+
+    Reader, parser and machine know a line by its number only, so a line of
+    a subroutine file would pass for the main file's line of that number.
+    Such lines get numbers from :data:`ELSEWHERE_LINES` up, which
+    ``diagnostics.elsewhere`` maps to their file and line, and which
+    :func:`_restore_line_numbers` turns back into the file's own numbers in
+    the finished operation.
+    """
+    numbers: dict[tuple[str, int], int] = {}
+    for sl in lines:
+        if sl.file != main:
+            key = (sl.file, sl.line)
+            number = numbers.get(key)
+            if number is None:
+                number = numbers[key] = ELSEWHERE_LINES + len(numbers)
+                diagnostics.elsewhere[number] = key
+            sl = dataclasses.replace(sl, line=number)
+        yield sl
+
+
+def _restore_line_numbers(table: CommandTable, diagnostics: Diagnostics) -> None:
+    """Rows from other files get their own files' line numbers back (see :func:`_number_other_files`)."""
+    if not diagnostics.elsewhere:
+        return
+    far = table.line >= ELSEWHERE_LINES
+    own = np.array([line for _, line in diagnostics.elsewhere.values()], table.line.dtype)
+    table.line[far] = own[table.line[far] - ELSEWHERE_LINES]
 
 
 class _MachineFeedback:
@@ -440,19 +476,24 @@ def _concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarr
 
 
 def quote_diagnostics(diagnostics: Diagnostics, program: Program, limit: int = 1000) -> None:
-    """Fill in the source text of diagnostics that were made without it."""
-    wanted = {d.line for d in diagnostics.items[:limit] if not d.text}
-    if not wanted:
-        return
-    found: dict[int, str] = {}
-    line_no = 0
-    for chunk in program.chunks():
-        for raw in chunk.split(b"\n")[:-1]:
-            line_no += 1
-            if line_no in wanted:
-                found[line_no] = raw[:200].decode("utf-8", "replace").rstrip("\r")
-        if len(found) == len(wanted):
-            break
+    """Fill in the source text of diagnostics that were made without it (from the file each names)."""
+    wanted: dict[str, set[int]] = {}
+    for d in diagnostics.items[:limit]:
+        if not d.text:
+            wanted.setdefault(d.file, set()).add(d.line)
+    found: dict[tuple[str, int], str] = {}
+    for file, lines in wanted.items():
+        source = program if file == diagnostics.file else Program(file, path=Path(file))
+        if source.path is not None and not source.path.is_file():
+            continue
+        line_no = 0
+        for chunk in source.chunks():
+            for raw in chunk.split(b"\n")[:-1]:
+                line_no += 1
+                if line_no in lines:
+                    found[file, line_no] = raw[:200].decode("utf-8", "replace").rstrip("\r")
+            if line_no >= max(lines):
+                break
     diagnostics.items = [
-        dataclasses.replace(d, text=found.get(d.line, "")) if not d.text else d for d in diagnostics.items
+        dataclasses.replace(d, text=found.get((d.file, d.line), "")) if not d.text else d for d in diagnostics.items
     ]

@@ -784,7 +784,7 @@ class _Run:
     def _report(self, line: SourceLine, column: int, message: str, *, kind: str = "syntax",
                 severity: str = "error") -> None:
         with self._as_file(line.file):
-            self.diagnostics.report(line.line, column, message, line.text, kind=kind, severity=severity)
+            self.diagnostics.report(line.line, column, message, line.text, kind=kind, severity=severity, file=line.file)
 
     @contextlib.contextmanager
     def _as_file(self, file: str):

@@ -291,7 +291,7 @@ class ParameterStage:
             return dataclasses.replace(line, text=number.group(1) or "")
         o_word = _O_WORD.match(text)
         if o_word:
-            diagnostics.report(line.line, o_word.start(1) + 1, O_WORD_MESSAGE, text, kind="syntax")
+            diagnostics.report(line.line, o_word.start(1) + 1, O_WORD_MESSAGE, text, kind="syntax", file=line.file)
             return dataclasses.replace(line, text="")
         return self.substitute(line, diagnostics)
 
@@ -310,7 +310,7 @@ class ParameterStage:
         except GcodeError as exc:
             kind = "limit" if isinstance(exc, GcodeLimitError) else "expression"
             where = exc.diagnostic  # every error raised here is located
-            diagnostics.report(line.line, where.column, where.message, text, kind=kind)
+            diagnostics.report(line.line, where.column, where.message, text, kind=kind, file=line.file)
             return dataclasses.replace(line, text="")
         return line if new == text else dataclasses.replace(line, text=new)
 

@@ -571,7 +571,7 @@ class _Run:
         return out
 
     def _report(self, sl: SourceLine, column: int, message: str, kind: str) -> None:
-        self.diagnostics.report(sl.line, column, message, sl.text, kind=kind)
+        self.diagnostics.report(sl.line, column, message, sl.text, kind=kind, file=sl.file)
 
 
 def _kind(exc: GcodeError) -> str:

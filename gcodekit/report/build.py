@@ -65,7 +65,9 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
         "filament_mm": stats["filament_mm"],
         "volume_mm3": None,
         "mass_g": None,
-        "diagnostics": [d.as_dict() for d in list(op.diagnostics)[:MAX_DIAGNOSTICS]],
+        # a problem in a subroutine file says which file
+        "diagnostics": [{**d.as_dict(), "elsewhere": Path(d.file).name if d.file != op.diagnostics.file else ""}
+                        for d in list(op.diagnostics)[:MAX_DIAGNOSTICS]],
         "diagnostics_total": len(op.diagnostics) + op.diagnostics.dropped,
         "errors": sum(1 for d in op.diagnostics if d.severity == "error"),
     }
