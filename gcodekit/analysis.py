@@ -40,12 +40,17 @@ def screw_extruder(op: "Operation") -> bool:
     return op.machine is not None and op.machine.extruder_type == "screw"
 
 
+def depositing_of(op: "Operation") -> np.ndarray:
+    """:func:`depositing` for an emulated operation, with its machine's kind of extruder."""
+    return depositing(op.waypoints, screw_extruder(op))
+
+
 def operation_statistics(op: "Operation") -> dict[str, Any]:
     """Counts, distances and time of an emulated operation (see ``get_statistics``)."""
     w = op.waypoints
     motion, distance, de = w["motion"], w["distance"], w["de"]
     moving = motion > 0
-    extruding = depositing(w, screw_extruder(op))
+    extruding = depositing_of(op)
     stats: dict[str, Any] = {
         "lines": op.n_lines,
         "commands": len(op.table),
@@ -97,7 +102,7 @@ def count_layers(op: "Operation") -> int:
         if count:
             return count
     w = op.waypoints
-    extruding = depositing(w, screw_extruder(op))
+    extruding = depositing_of(op)
     return int(np.unique(np.round(w["z"][extruding], 4)).size)
 
 
@@ -154,7 +159,7 @@ def layers(op: "Operation", heights: np.ndarray | None = None) -> np.ndarray:
         if (marks >= 0).any():
             return marks[waypoint_rows(op)]
         heights = op.waypoints["z"]
-    extruding = np.flatnonzero(depositing(op.waypoints, screw_extruder(op)))
+    extruding = np.flatnonzero(depositing_of(op))
     z = np.round(np.asarray(heights, float), 4)
     at = z[extruding]
     starts = extruding[np.r_[True, at[1:] != at[:-1]]] if extruding.size else extruding
@@ -184,7 +189,7 @@ def time_by(op: "Operation", key: str = "layer") -> "pd.DataFrame":
     check_choice("key", key, ("layer", "feature", "tool"))
     w = op.waypoints
     labels = {"layer": layers, "feature": features, "tool": lambda o: np.asarray(o.waypoints["tool"])}[key](op)
-    extruding = depositing(w, screw_extruder(op))
+    extruding = depositing_of(op)
     frame = pd.DataFrame({
         key: labels,
         "time_s": np.nan_to_num(np.asarray(w["time"], float)),

@@ -50,13 +50,13 @@ def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
     The work is the depositing moves from the first layer on (start-code purge
     lines are not the part) or, for a mill, the feed moves.
     """
-    from .analysis import depositing, layers, screw_extruder
+    from .analysis import depositing_of, layers
 
     w = op.waypoints
     moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
     moving[:1] = False  # a move is drawn from the waypoint before it
     if _is_additive(op):
-        work = depositing(w, screw_extruder(op)) & (layers(op) >= 0)
+        work = depositing_of(op) & (layers(op) >= 0)
     else:
         work = np.asarray(w["motion"]) >= 2
     work &= moving

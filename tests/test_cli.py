@@ -8,17 +8,13 @@ from pathlib import Path
 
 import pytest
 
+from cli_helpers import run
+
 from gcodekit import cli
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 MILL = EXAMPLES / "bracket_mill.ngc"
 PRINT = EXAMPLES / "cube20_prusaslicer_marlin.gcode"
-
-
-def run(args, capsys):
-    status = cli.main([str(a) for a in args])
-    out = capsys.readouterr()
-    return status, out.out, out.err
 
 
 def test_info_json_has_the_documented_keys(capsys):

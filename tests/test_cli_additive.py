@@ -8,18 +8,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from gcodekit import cli
+from cli_helpers import run
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 MILL = EXAMPLES / "bracket_mill.ngc"
 PRINT = EXAMPLES / "cube20_prusaslicer_marlin.gcode"
 DOME = EXAMPLES / "dome_ded_beckhoff.nc"
-
-
-def run(args, capsys):
-    status = cli.main([str(a) for a in args])
-    out = capsys.readouterr()
-    return status, out.out, out.err
 
 
 def test_parquet_holds_the_csv_table(tmp_path, capsys):

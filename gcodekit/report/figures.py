@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..analysis import depositing, features, layers, screw_extruder
+from ..analysis import depositing_of, features, layers
 from ..emulate.arcs import PLANES, sweep
 
 if TYPE_CHECKING:
@@ -69,7 +69,7 @@ def toolpath_segments(op: "Operation") -> Segments:
     xyz = np.column_stack([w["x"], w["y"], w["z"]]).astype(float)
     prev = np.vstack([xyz[:1], xyz[:-1]])
     moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
-    keep = depositing(w, screw_extruder(op)) if additive else moving
+    keep = depositing_of(op) if additive else moving
     idx = np.flatnonzero(keep)
     labels = None
     if additive:
