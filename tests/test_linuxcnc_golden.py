@@ -117,8 +117,8 @@ def ours_like_canon(op) -> pd.DataFrame:
     spline = np.isin(op.table.name[rows], SPLINES)
     last_of_command = np.r_[rows[1:] != rows[:-1], True]
     keep = ~spline | last_of_command
-    # G33 moves at K per spindle revolution; the canon keeps printing the modal F
-    ours["synced"] = op.table.name[rows] == NAME_ID["thread"]
+    # G33 and G76's threading feeds move at a pitch per spindle revolution; the canon keeps printing the modal F
+    ours["synced"] = np.isin(op.table.name[rows], [NAME_ID["thread"], NAME_ID["cycle_thread"]]) & (ours["motion"] == "feed")
     ours = ours[keep].reset_index(drop=True)
     ours.loc[spline[keep], "motion"] = "spline"
     return ours

@@ -20,6 +20,7 @@ from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, M
 from ..parse.commands import Kind
 from .cycles import CYCLES, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
+from .threading import ThreadingError, check_words, threading_moves
 from .splines import SPLINE_NAMES, SplineBlocks
 from .state import AXES, MachineState
 from .tooltable import Tool
@@ -37,7 +38,8 @@ SPECIAL_NAMES = frozenset(
     firmware_retract firmware_unretract set_kinematic_position
     tool_length_offset tool_length_offset_dynamic tool_length_offset_add cancel_tool_length
     coordinate_data local_offset retract_initial retract_r laser_on laser_off deposition_switch set_bead polar_on polar_off diameter_mode radius_mode
-    cutter_comp_off cutter_comp_left cutter_comp_right cutter_comp_left_dynamic cutter_comp_right_dynamic""".split()
+    cutter_comp_off cutter_comp_left cutter_comp_right cutter_comp_left_dynamic cutter_comp_right_dynamic
+    cycle_thread""".split()
 ) | {f"work_offset_{k}" for k in range(1, 10)} | SPLINE_NAMES
 
 _MOVING_KINDS = frozenset(int(k) for k in (Kind.MOVE, Kind.MOVE_EXTRUDE, Kind.MOVE_MILL, Kind.EXTRUDE))
@@ -88,6 +90,7 @@ class ModalHandler:
         self._tool_change_line = -1  # source line of the last M6 (see tool length offsets)
         self.splines = SplineBlocks(machine.config.spline_tolerance)
         self.cycle_mode_open = False  # the last chunk ended in a canned-cycle mode
+        self._cycle_name = ""  # the canned cycle whose mode is in force (axis words alone repeat it)
 
     @property
     def state(self) -> MachineState:
@@ -115,9 +118,14 @@ class ModalHandler:
                                                                 name.startswith("work_offset_")):
             self.machine.diagnostics.report(line, 1, "the program zero may not change while polar coordinates (G16) "
                                             "are on", kind="machine")
+        repeat = moves and int(t.motion[row]) == MOTION_CYCLE and not name
         if name in LATHE_CYCLES:
             motion, extra = self._lathe_cycle(name, params, t.command(row).comment, line)
+        elif name == "cycle_thread" or (repeat and self._cycle_name == "cycle_thread"):
+            self._cycle_name = "cycle_thread"
+            motion, extra = self._threading_cycle(params, line)
         elif moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
+            self._cycle_name = name or self._cycle_name
             if not (int(t.motion[row - 1]) == MOTION_CYCLE if row else self.cycle_mode_open):
                 s.cycle.initial = None  # the cycle mode begins here
             motion, extra = self._cycle(name, params, line)
@@ -251,6 +259,37 @@ class ModalHandler:
         s.position = steps[-1].point.copy()
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
+
+    def _threading_cycle(self, params: dict, line: int) -> tuple[int, list[Waypoint]]:
+        """G76: the passes of a threading cycle become waypoints (see :mod:`.threading`)."""
+        s = self.state
+        try:
+            check_words(params, s.compensating)
+        except ThreadingError as exc:
+            self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
+            return MOTION_NONE, []
+        k = s.units
+        halve = 2.0 if s.diameter else 1.0  # I, J and K are diameters in G7 (X words are already radii)
+        program = s.program_position()
+        end = program.copy()
+        for ax, letter in ((0, "X"), (2, "Z")):
+            if letter in params:
+                end[ax] = (program[ax] if s.incremental else 0.0) + params[letter] * k
+        moves = threading_moves((program[0], program[2]), end[2], p=params["P"] * k, i=params["I"] * k / halve,
+                                j=params["J"] * k / halve, k=params["K"] * k / halve, q=params.get("Q", 0.0),
+                                h=int(params.get("H", 0)), r=params.get("R", 1.0), e=params.get("E", 0.0) * k,
+                                taper=int(params.get("L", 0)))
+        offset = s.offset
+        steps = []
+        for kind, x, z, pitch in moves + [("rapid", end[0], end[2], None)]:
+            point = program.copy()
+            point[0], point[2] = x, z
+            values = {**dict(zip(AXES.lower(), point + offset)), "motion": MOTION_RAPID}
+            if pitch is not None:  # synchronized with the spindle: pitch per revolution
+                values.update(motion=MOTION_LINEAR, feed=pitch * s.speed)
+            steps.append(Waypoint(values))
+        s.position = end + offset
+        return MOTION_RAPID, steps[:-1]
 
     def _lathe_cycle(self, name: str, params: dict, comment: str | None, line: int) -> tuple[int, list[Waypoint]]:
         """G70-G72: the moves of a lathe cycle become waypoints (see :mod:`.lathe`)."""
@@ -501,7 +540,8 @@ class ModalHandler:
     def _fill_passing(self, w: Waypoint, before: np.ndarray) -> None:
         point = np.array([w.values[k] for k in AXES.lower()])
         distance = float(np.linalg.norm((point - before)[:3]))
-        rate = self._rate(int(w.values.get("motion", MOTION_RAPID)))
+        motion = int(w.values.get("motion", MOTION_RAPID))
+        rate = w.values["feed"] if "feed" in w.values and motion == MOTION_LINEAR else self._rate(motion)
         dwell = w.values.pop("dwell", 0.0)
         w.values.update(distance=distance, time=(distance / (rate / 60.0) if distance and rate > 0 else 0.0) + dwell,
                         de=0.0)

@@ -25,7 +25,7 @@ from ..syntax.flavor import code_label
 AXIS_LETTERS = frozenset("XYZABCUVW@^")  # @ and ^: LinuxCNC's polar X/Y
 CYCLES = frozenset({"cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
                     "cycle_bore_stop", "cycle_bore_dwell", "cycle_tap", "cycle_tap_left", "cycle_back_bore",
-                    "cycle_bore_manual", "lathe_finish", "lathe_rough", "lathe_rough_no_pockets",
+                    "cycle_bore_manual", "cycle_thread", "lathe_finish", "lathe_rough", "lathe_rough_no_pockets",
                     "lathe_rough_pockets", "lathe_face", "lathe_face_no_pockets", "lathe_face_pockets"})
 #: Commands that take axis words in the same block.
 AXIS_CONSUMERS = frozenset(

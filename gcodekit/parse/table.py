@@ -31,7 +31,7 @@ MOTION_THREAD = 9
 #: Canned cycles: the command table's motion is MOTION_CYCLE (never a waypoint's)
 CYCLE_NAMES = ("cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_peck", "cycle_bore",
                "cycle_bore_stop", "cycle_bore_dwell", "cycle_tap", "cycle_tap_left", "cycle_back_bore",
-               "cycle_bore_manual") + tuple(LATHE_CYCLE_NAMES := (
+               "cycle_bore_manual", "cycle_thread") + tuple(LATHE_CYCLE_NAMES := (
                    "lathe_finish", "lathe_rough", "lathe_rough_no_pockets", "lathe_rough_pockets",
                    "lathe_face", "lathe_face_no_pockets", "lathe_face_pockets"))
 
