@@ -118,7 +118,12 @@ def ours_like_canon(op) -> pd.DataFrame:
     last_of_command = np.r_[rows[1:] != rows[:-1], True]
     keep = ~spline | last_of_command
     # G33 and G76's threading feeds move at a pitch per spindle revolution; the canon keeps printing the modal F
-    ours["synced"] = np.isin(op.table.name[rows], [NAME_ID["thread"], NAME_ID["cycle_thread"]]) & (ours["motion"] == "feed")
+    ours["synced"] = np.isin(op.table.name[rows], [NAME_ID["thread"], NAME_ID["cycle_thread"], NAME_ID["rigid_tap"]]) \
+        & (ours["motion"] == "feed")
+    # a rigid tap (G33.1) is one RIGID_TAP to the bottom in the canon; gcodekit also moves back out
+    tapping = op.table.name[rows] == NAME_ID["rigid_tap"]
+    ours.loc[tapping & ~last_of_command, "motion"] = "RIGID_TAP"
+    keep &= ~(tapping & last_of_command)
     ours = ours[keep].reset_index(drop=True)
     ours.loc[spline[keep], "motion"] = "spline"
     return ours

@@ -60,3 +60,14 @@ def test_axis_words_alone_repeat_the_cycle():
     op = gcodekit.gcode_to_operation("G18 G21\nS300 M3\nG0 X10 Z5\nG76 P1 Z-5 I-0.5 J0.2 K0.6\nX14 Z4\nM2\n",
                                      "linuxcnc", plan=False)
     assert [(d.line, d.message) for d in op.diagnostics if d.severity == "error"] == [(5, "P word missing with G76")]
+
+
+def test_rigid_tap_goes_in_and_back_out_at_the_pitch():
+    # K1.25 at 500 rpm: 625 mm/min, 12 mm down and 12 mm back up
+    op = gcodekit.gcode_to_operation("G21 G90\nS500 M3\nG0 X5 Y5 Z2\nG33.1 Z-10 K1.25\nM2\n", "linuxcnc", plan=False)
+    w = op.waypoints
+    feeds = w["motion"] == 2
+    np.testing.assert_allclose(w["z"][feeds], [-10.0, 2.0])
+    np.testing.assert_allclose(w["time"][feeds], 12.0 / 625.0 * 60.0)
+    refused = gcodekit.gcode_to_operation("G21\nG0 Z2\nG33.1 Z-10 K1\nM2\n", "linuxcnc", plan=False)
+    assert [(d.line, d.message) for d in refused.diagnostics] == [(3, "Spindle not turning in G33.1")]

@@ -91,6 +91,7 @@ class ModalHandler:
         self.splines = SplineBlocks(machine.config.spline_tolerance)
         self.cycle_mode_open = False  # the last chunk ended in a canned-cycle mode
         self._cycle_name = ""  # the canned cycle whose mode is in force (axis words alone repeat it)
+        self._thread_name = "thread"  # G33 or G33.1: which one axis words alone repeat
 
     @property
     def state(self) -> MachineState:
@@ -130,9 +131,16 @@ class ModalHandler:
                 s.cycle.initial = None  # the cycle mode begins here
             motion, extra = self._cycle(name, params, line)
         elif moves and int(t.motion[row]) == MOTION_THREAD:
-            rate = self._thread(params, line)
+            rigid = name == "rigid_tap" or (not name and self._thread_name == "rigid_tap")
+            self._thread_name = "rigid_tap" if rigid else "thread"
+            tap = self._rigid_tap(params, line) if rigid else None
+            rate = tap.values["feed"] if tap is not None else None if rigid else self._thread(params, line)
             if rate is not None:
                 s.program_shift[:] = 0.0
+                if tap is not None:  # in to the bottom, then out again at the same pitch
+                    extra = [tap]
+                    self._fill_passing(tap, before)
+                    before = np.array([tap.values[k] for k in AXES.lower()])
                 self._write(out, row, before, MOTION_LINEAR, feed=rate)
                 return extra
         elif name in SPLINE_NAMES or (moves and int(t.motion[row]) in SPLINE_MOTIONS):
@@ -340,6 +348,27 @@ class ModalHandler:
                 program[ax] = (program[ax] if s.incremental else 0.0) + params[letter] * scale[ax]
         self._move_to(program, params)
         return params["K"] * scale[2] * s.speed
+
+    def _rigid_tap(self, params: dict, line: int) -> Waypoint | None:
+        """G33.1: the bottom of a rigid tap (K units per spindle revolution); the tool returns to where it was.
+
+        Returns the waypoint at the bottom, its feed the synchronized rate
+        (mm/min), or None when rs274 refuses the block.
+        """
+        s = self.state
+        problem = ("K word missing with g33/g33.1" if "K" not in params else
+                   "F word used with a g33/g33.1" if "F" in params else
+                   "Spindle not turning in G33.1" if s.spindle == 0 or s.speed <= 0 else "")
+        if problem:
+            self.machine.diagnostics.report(line, 1, problem, kind="machine")
+            return None
+        scale = s.scale()
+        bottom = s.program_position()
+        for ax, letter in enumerate("XYZ"):
+            if letter in params:
+                bottom[ax] = (bottom[ax] if s.incremental else 0.0) + params[letter] * scale[ax]
+        rate = params["K"] * scale[2] * s.speed
+        return Waypoint({**dict(zip(AXES.lower(), bottom + s.offset)), "motion": MOTION_LINEAR, "feed": rate})
 
     def _spline(self, t: CommandTable, row: int, name: str, params: dict) -> tuple[int, list[Waypoint]]:
         """G5, G5.1, G5.2/G5.3 and the control points between: the curve's chords become

@@ -37,7 +37,8 @@ _LETTER_ROW[[ord(c) for c in PARAM_LETTERS]] = np.arange(len(PARAM_LETTERS))
 #: Motion modes by command name.  A probe (G38.x) is a straight feed to its
 #: target: without a probe input it never trips, as in rs274 standalone.
 _MOTION_MODES = {**MOTION_OF_NAME, "probe": MOTION_LINEAR, "spline_cubic": MOTION_CUBIC,
-                 "spline_quadratic": MOTION_QUADRATIC, "nurbs_start": MOTION_NURBS, "thread": MOTION_THREAD}
+                 "spline_quadratic": MOTION_QUADRATIC, "nurbs_start": MOTION_NURBS, "thread": MOTION_THREAD,
+                 "rigid_tap": MOTION_THREAD}
 
 
 class GcodeParser:

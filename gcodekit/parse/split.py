@@ -31,7 +31,7 @@ CYCLES = frozenset({"cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cyc
 AXIS_CONSUMERS = frozenset(
     {"rapid", "linear", "arc_cw", "arc_ccw", "set_position", "home", "home_secondary",
      "machine_coordinates", "probe", "coordinate_data", "local_offset", "tool_length_offset_dynamic",
-     "spline_cubic", "spline_quadratic", "nurbs_start", "thread"}
+     "spline_cubic", "spline_quadratic", "nurbs_start", "thread", "rigid_tap"}
 ) | CYCLES
 MOTIONS = frozenset({"rapid", "linear", "arc_cw", "arc_ccw", "probe", "cancel_cycle", "spline_cubic",
                      "spline_quadratic", "nurbs_start", "nurbs_end", "thread"}) | CYCLES

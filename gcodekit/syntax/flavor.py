@@ -41,7 +41,7 @@ COMMANDS = frozenset(
     cutter_comp_off cutter_comp_left cutter_comp_right cutter_comp_left_dynamic cutter_comp_right_dynamic
     cancel_cycle exact_stop path_blending retract_initial retract_r
     cycle_drill cycle_drill_dwell cycle_peck cycle_chip_break cycle_bore cycle_bore_stop cycle_bore_dwell
-    cycle_tap cycle_tap_left cycle_back_bore cycle_bore_manual cycle_thread
+    cycle_tap cycle_tap_left cycle_back_bore cycle_bore_manual cycle_thread rigid_tap
     lathe_finish lathe_rough lathe_rough_no_pockets lathe_rough_pockets lathe_face lathe_face_no_pockets lathe_face_pockets
     set_hotend_temp wait_hotend_temp set_bed_temp wait_bed_temp set_chamber_temp
     fan_on fan_off

@@ -9,7 +9,7 @@ A program qualifies when ``RESULTS.tsv`` marks it ``ok``, it has motions, all
 of them matched to a source line (``line_match`` ok, ``nurbs`` for splines,
 or ``order`` for moves rs274 emitted late), no rotary-axis work or G92 offset is active (the CSV
 only carries X/Y/Z offsets), its text (comments stripped) uses no feature
-gcodekit does not emulate yet (:data:`EXCLUDED_G`: G33.1;
+gcodekit does not emulate yet (:data:`EXCLUDED_G`;
 I/O M-codes, user or unknown
 codes, system parameters other than the probe results #5061-#5070 and the
 machine-state ones of :mod:`gcodekit.emulate.state_parameters`), and it is
@@ -79,11 +79,9 @@ KNOWN_GAPS = {
 }
 
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
-EXCLUDED_G = {
-    "33.1": "rigid tapping",
-}
+EXCLUDED_G: dict[str, str] = {}
 ALLOWED_G = frozenset("""
-0 1 2 3 4 5 5.1 5.2 5.3 7 8 10 17 33 70 71 76 71.1 71.2 72 72.1 72.2 17.1 38.2 38.3 38.4 38.5 41.1 42.1 73 74 81 82 83 84 85 86 87 88 89 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 41 42 43 43.1 43.2 49 52 53 54 55 56 57 58
+0 1 2 3 4 5 5.1 5.2 5.3 7 8 10 17 33 33.1 70 71 76 71.1 71.2 72 72.1 72.2 17.1 38.2 38.3 38.4 38.5 41.1 42.1 73 74 81 82 83 84 85 86 87 88 89 18 18.1 19 19.1 20 21 28 28.1 30 30.1 40 41 42 43 43.1 43.2 49 52 53 54 55 56 57 58
 59 59.1 59.2 59.3 61 61.1 64 80 90 90.1 91 91.1 92 92.1 92.2 92.3 93 94 95 96 97
 98 99
 """.split())
