@@ -88,3 +88,18 @@ def test_only_g70_runs_under_compensation(cycle: str, refused: bool) -> None:
     errors = [(d.line, d.message) for d in op.diagnostics if d.severity == "error"]
     refusal = (9, f"{cycle}.0 cannot be used with cutter compensation enabled")
     assert (refusal in errors) == refused
+
+
+def test_axis_words_alone_continue_in_the_cycles_last_mode() -> None:
+    """rs274 (checked with run_rs274.sh): after this G71, whose last move climbs back to X6, the mode
+    is G1; after a G70 whose profile ends in an arc it is that arc's, so "X8 Z4" then lacks its I/K
+    ("R i j k words all missing for arc")."""
+    arc_end = PROFILE.replace("G1 X5\n", "G2 X6 Z-7 I2 K0\n")
+    after_rough = gcodekit.gcode_to_operation(PROFILE.format(cycle="G71 Q100 X6 Z1 D0.2 I0.5\nX8 Z4"),
+                                              machine="linuxcnc", plan=False)
+    last = after_rough.motions().iloc[-1]
+    assert (last.motion, last.x, last.z, last.line) == ("feed", 8.0, 4.0, 9)
+    after_finish = gcodekit.gcode_to_operation(arc_end.format(cycle="G70 Q100 X6 Z1\nX8 Z4"),
+                                               machine="linuxcnc", plan=False)
+    errors = [(d.line, d.message) for d in after_finish.diagnostics if d.severity == "error"]
+    assert errors == [(9, "R i j k words all missing for arc")]

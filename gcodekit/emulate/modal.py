@@ -92,6 +92,7 @@ class ModalHandler:
         self.cycle_mode_open = False  # the last chunk ended in a canned-cycle mode
         self._cycle_name = ""  # the canned cycle whose mode is in force (axis words alone repeat it)
         self._thread_name = "thread"  # G33 or G33.1: which one axis words alone repeat
+        self._lathe_motion = MOTION_LINEAR  # the mode a lathe cycle's last move left in force
 
     @property
     def state(self) -> MachineState:
@@ -121,7 +122,11 @@ class ModalHandler:
                                             "are on", kind="machine")
         repeat = moves and int(t.motion[row]) == MOTION_CYCLE and not name
         if name in LATHE_CYCLES:
+            self._cycle_name = name
             motion, extra = self._lathe_cycle(name, params, t.command(row).comment, line)
+            self._lathe_motion = motion
+        elif repeat and self._cycle_name in LATHE_CYCLES:
+            motion = self._after_lathe_cycle(params, line)
         elif name == "cycle_thread" or (repeat and self._cycle_name == "cycle_thread"):
             self._cycle_name = "cycle_thread"
             motion, extra = self._threading_cycle(params, line)
@@ -298,6 +303,24 @@ class ModalHandler:
             steps.append(Waypoint(values))
         s.position = end + offset
         return MOTION_RAPID, steps[:-1]
+
+    def _after_lathe_cycle(self, params: dict, line: int) -> int:
+        """Axis words alone after G70-G72: a move in the mode of the cycle's last move (rs274's
+        ``motion_mode`` after the cycle ran its moves through ``convert_straight``/``convert_arc``)."""
+        s = self.state
+        motion = self._lathe_motion
+        if motion in (MOTION_CW, MOTION_CCW):
+            message = ("R i j k words all missing for arc" if not any(k in params for k in "IJKR") else
+                       "an arc in the mode a lathe cycle left in force is not emulated; write G2 or G3")
+            self.machine.diagnostics.report(line, 1, message, kind="machine")
+            return MOTION_NONE
+        program = s.program_position()
+        scale = s.scale()
+        for ax, letter in enumerate("XY"):
+            if letter in params:
+                program[ax] = (program[ax] if s.incremental else 0.0) + params[letter] * scale[ax]
+        self._move_to(program, params)
+        return motion or MOTION_LINEAR
 
     def _lathe_cycle(self, name: str, params: dict, comment: str | None, line: int) -> tuple[int, list[Waypoint]]:
         """G70-G72: the moves of a lathe cycle become waypoints (see :mod:`.lathe`)."""

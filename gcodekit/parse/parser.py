@@ -275,10 +275,9 @@ class GcodeParser:
             sets[name == NAME_ID[mname]] = mode
         sets[(name == NAME_ID["cancel_cycle"]) | (name == NAME_ID["nurbs_end"])] = MOTION_NONE
         sets[np.isin(name, self._cycle_ids)] = MOTION_CYCLE
-        # A lathe cycle (G70-G72) is no motion mode: rs274 leaves the mode of its
-        # last move in force, a feed (G1) but after a G70 ending in an arc.
+        # After a lathe cycle (G70-G72) rs274 is in the mode of the cycle's last move,
+        # which only the machine knows: axis words alone stay cycle rows for it to settle
         lathe = np.isin(name, self._lathe_ids)
-        sets[lathe] = MOTION_LINEAR
         g53 = name == NAME_ID["machine_coordinates"]
         for i in np.flatnonzero(g53 & (letter != 0)):
             part = t.get("parts_by_row", {}).get(int(i))
