@@ -307,19 +307,13 @@ class ModalHandler:
     def _after_lathe_cycle(self, params: dict, line: int) -> int:
         """Axis words alone after G70-G72: a move in the mode of the cycle's last move (rs274's
         ``motion_mode`` after the cycle ran its moves through ``convert_straight``/``convert_arc``)."""
-        s = self.state
         motion = self._lathe_motion
         if motion in (MOTION_CW, MOTION_CCW):
             message = ("R i j k words all missing for arc" if not any(k in params for k in "IJKR") else
                        "an arc in the mode a lathe cycle left in force is not emulated; write G2 or G3")
             self.machine.diagnostics.report(line, 1, message, kind="machine")
             return MOTION_NONE
-        program = s.program_position()
-        scale = s.scale()
-        for ax, letter in enumerate("XY"):
-            if letter in params:
-                program[ax] = (program[ax] if s.incremental else 0.0) + params[letter] * scale[ax]
-        self._move_to(program, params)
+        self._move_to(self._program_target(params), params)
         return motion or MOTION_LINEAR
 
     def _lathe_cycle(self, name: str, params: dict, comment: str | None, line: int) -> tuple[int, list[Waypoint]]:
@@ -355,22 +349,34 @@ class ModalHandler:
         self._last_centre = tuple(last.get(k, np.nan) for k in ("cx", "cy", "cz"))
         return int(last["motion"]), steps[:-1]
 
-    def _thread(self, params: dict, line: int) -> float | None:
-        """G33: a straight move at K units per spindle revolution; returns its feed (mm/min), None if refused."""
+    def _program_target(self, params: dict, letters: str = "XY") -> np.ndarray:
+        """The program position moved by the words ``letters`` (absolute or incremental), mm."""
+        s = self.state
+        scale = s.scale()
+        target = s.program_position()
+        for letter in letters:
+            if letter in params:
+                ax = AXES.index(letter)
+                target[ax] = (target[ax] if s.incremental else 0.0) + params[letter] * scale[ax]
+        return target
+
+    def _synchronized_rate(self, params: dict, line: int, code: str) -> float | None:
+        """Feed (mm/min) of a G33/G33.1 move, K units per spindle revolution; None (reported) if rs274 refuses it."""
         s = self.state
         problem = ("K word missing with g33/g33.1" if "K" not in params else
                    "F word used with a g33/g33.1" if "F" in params else
-                   "Spindle not turning in G33" if s.spindle == 0 or s.speed <= 0 else "")
+                   f"Spindle not turning in {code}" if s.spindle == 0 or s.speed <= 0 else "")
         if problem:
             self.machine.diagnostics.report(line, 1, problem, kind="machine")
             return None
-        scale = s.scale()
-        program = s.program_position()
-        for ax, letter in enumerate("XY"):
-            if letter in params:
-                program[ax] = (program[ax] if s.incremental else 0.0) + params[letter] * scale[ax]
-        self._move_to(program, params)
-        return params["K"] * scale[2] * s.speed
+        return params["K"] * s.scale()[2] * s.speed
+
+    def _thread(self, params: dict, line: int) -> float | None:
+        """G33: a straight move at K units per spindle revolution; returns its feed (mm/min), None if refused."""
+        rate = self._synchronized_rate(params, line, "G33")
+        if rate is not None:
+            self._move_to(self._program_target(params), params)
+        return rate
 
     def _rigid_tap(self, params: dict, line: int) -> Waypoint | None:
         """G33.1: the bottom of a rigid tap (K units per spindle revolution); the tool returns to where it was.
@@ -378,20 +384,11 @@ class ModalHandler:
         Returns the waypoint at the bottom, its feed the synchronized rate
         (mm/min), or None when rs274 refuses the block.
         """
-        s = self.state
-        problem = ("K word missing with g33/g33.1" if "K" not in params else
-                   "F word used with a g33/g33.1" if "F" in params else
-                   "Spindle not turning in G33.1" if s.spindle == 0 or s.speed <= 0 else "")
-        if problem:
-            self.machine.diagnostics.report(line, 1, problem, kind="machine")
+        rate = self._synchronized_rate(params, line, "G33.1")
+        if rate is None:
             return None
-        scale = s.scale()
-        bottom = s.program_position()
-        for ax, letter in enumerate("XYZ"):
-            if letter in params:
-                bottom[ax] = (bottom[ax] if s.incremental else 0.0) + params[letter] * scale[ax]
-        rate = params["K"] * scale[2] * s.speed
-        return Waypoint({**dict(zip(AXES.lower(), bottom + s.offset)), "motion": MOTION_LINEAR, "feed": rate})
+        bottom = self._program_target(params, "XYZ") + self.state.offset
+        return Waypoint({**dict(zip(AXES.lower(), bottom)), "motion": MOTION_LINEAR, "feed": rate})
 
     def _spline(self, t: CommandTable, row: int, name: str, params: dict) -> tuple[int, list[Waypoint]]:
         """G5, G5.1, G5.2/G5.3 and the control points between: the curve's chords become
