@@ -138,16 +138,20 @@ class ModalHandler:
         elif moves and int(t.motion[row]) == MOTION_THREAD:
             rigid = name == "rigid_tap" or (not name and self._thread_name == "rigid_tap")
             self._thread_name = "rigid_tap" if rigid else "thread"
-            tap = self._rigid_tap(params, line) if rigid else None
-            rate = tap.values["feed"] if tap is not None else None if rigid else self._thread(params, line)
-            if rate is not None:
-                s.program_shift[:] = 0.0
+            if rigid:
+                tap = self._rigid_tap(params, line)
                 if tap is not None:  # in to the bottom, then out again at the same pitch
-                    extra = [tap]
+                    s.program_shift[:] = 0.0
                     self._fill_passing(tap, before)
-                    before = np.array([tap.values[k] for k in AXES.lower()])
-                self._write(out, row, before, MOTION_LINEAR, feed=rate)
-                return extra
+                    bottom = np.array([tap.values[k] for k in AXES.lower()])
+                    self._write(out, row, bottom, MOTION_LINEAR, feed=tap.values["feed"])
+                    return [tap]
+            else:
+                rate = self._thread(params, line)
+                if rate is not None:
+                    s.program_shift[:] = 0.0
+                    self._write(out, row, before, MOTION_LINEAR, feed=rate)
+                    return extra
         elif name in SPLINE_NAMES or (moves and int(t.motion[row]) in SPLINE_MOTIONS):
             motion, extra = self._spline(t, row, name, params)
         elif moves and ("@" in params or "^" in params):
@@ -284,10 +288,7 @@ class ModalHandler:
         k = s.units
         halve = 2.0 if s.diameter else 1.0  # I, J and K are diameters in G7 (X words are already radii)
         program = s.program_position()
-        end = program.copy()
-        for ax, letter in ((0, "X"), (2, "Z")):
-            if letter in params:
-                end[ax] = (program[ax] if s.incremental else 0.0) + params[letter] * k
+        end = self._program_target(params, "XZ")
         moves = threading_moves((program[0], program[2]), end[2], p=params["P"] * k, i=params["I"] * k / halve,
                                 j=params["J"] * k / halve, k=params["K"] * k / halve, q=params.get("Q", 0.0),
                                 h=int(params.get("H", 0)), r=params.get("R", 1.0), e=params.get("E", 0.0) * k,

@@ -23,7 +23,6 @@ from __future__ import annotations
 import math
 
 
-
 class ThreadingError(ValueError):
     """A G76 block the cycle refuses; the message is rs274's."""
 
