@@ -216,7 +216,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     from .emulate.compensation import compensate, uses_compensation
 
     if uses_compensation(op):
-        compensate(op, m.tools)
+        compensate(op, m.tools, m.comp_profile_ends)
     if plan and config.planner:
         from .emulate.planners import planner_settings, run_planner
 

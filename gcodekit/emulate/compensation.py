@@ -25,7 +25,11 @@ tool off it by the tool radius, after the rules of LinuxCNC's interpreter
   end of that feed to the corner as well, so its arc ends where it starts:
   gcodekit keeps the arc, matching rs274 only when the next move is tangent);
 * gouges are errors, as in rs274: an offset line that would run backwards
-  between its corners, or an inside corner whose offset paths never meet.
+  between its corners, or an inside corner whose offset paths never meet;
+* a G70 under compensation inherits a quirk of rs274's: reading the profile
+  leaves rs274's current point on the profile's last point, so the cycle's
+  first rapid (to where the programmed point already is) takes the tool
+  there, uncompensated, and the next corner is judged from there.
 
 Runs once over the emulated waypoints of programs that use G41/G42; it is a
 per-move Python loop because each corner depends on the move before.
@@ -56,8 +60,12 @@ def uses_compensation(op: "Operation") -> bool:
     return bool(np.isin(op.table.name, [k for k, side in _SIDES.items() if side]).any())
 
 
-def compensate(op: "Operation", tools) -> None:
-    """Rewrite ``op.waypoints`` with the compensated tool path (in place)."""
+def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]] = ()) -> None:
+    """Rewrite ``op.waypoints`` with the compensated tool path (in place).
+
+    ``profile_ends``: (source line, machine X Y Z) of each G70 run under
+    compensation, in order (``Machine.comp_profile_ends``).
+    """
     w = op.waypoints
     t = op.table
     n = w["x"].size
@@ -79,7 +87,9 @@ def compensate(op: "Operation", tools) -> None:
     tool_changes = set(np.flatnonzero(t.name == NAME_ID["tool_change"]).tolist())
     held: dict[str, float] = {}  # plane axes rs274 re-read from the tool after an M6 (see below)
     current_row = -1
+    nth = 0  # waypoint k is the nth of its command
     entry_row = -1  # the command whose entry length was refused
+    profile_ends = list(profile_ends)
 
     def emit(k: int, **changes) -> int:
         for key in columns:
@@ -92,6 +102,7 @@ def compensate(op: "Operation", tools) -> None:
         row = int(rows[k])
         (f, g, _), _ = PLANES[int(columns["plane"][k])]
         a, b = "xyz"[f], "xyz"[g]
+        nth = nth + 1 if row == current_row else 0
         if row != current_row:
             for r in range(current_row + 1, row + 1):  # comp codes between the waypoints
                 if r in side_rows:
@@ -142,6 +153,16 @@ def compensate(op: "Operation", tools) -> None:
             emit(k)  # straight from the compensated point to the programmed end
             mode, last_dir, last_corner, pending, last_path = "off", None, None, None, None
             pending_start, pending_dir = None, None
+            continue
+        if mode == "on" and nth == 1 and profile_ends and profile_ends[0][0] == int(t.line[row]) \
+                and int(t.name[row]) == NAME_ID["lathe_finish"]:
+            # the G70's first own rapid (its approach to the cycle point came before): the tool
+            # goes to the profile's end, queued behind the approach; the next corner is judged
+            # from the programmed point to there
+            tool_at = profile_ends.pop(0)[1][[f, g]]
+            staying.append(emit(k, **{a: tool_at[0], b: tool_at[1]}))
+            last_dir = -side * _left(_unit(tool_at - programmed_start))
+            last_path = ("line", tool_at, last_dir)
             continue
         chord = end - programmed_start
         if mode == "entry" and entry_row != row and motion < MOTION_CW and np.hypot(*(end - start)) < radius - _TINY \
@@ -211,6 +232,10 @@ def compensate(op: "Operation", tools) -> None:
         # within CONCAVE_CORNER of straight on, rs274 neither rolls round nor trims: the
         # move starts where the tool is
         if gap > _TINY and abs(beta) > CONCAVE_CORNER:
+            if beta > 0:
+                for r in (pending, *staying):  # the moves before end where the tool is (a no-op but after a G70)
+                    if r is not None:
+                        out[a][r], out[b][r] = start[0], start[1]
             if beta > 0 and motion == MOTION_RAPID:
                 # no rapid arc: rs274 traverses straight to where the roll would end
                 whole = float(columns["distance"][k])  # at the rapid's own speed
@@ -223,8 +248,12 @@ def compensate(op: "Operation", tools) -> None:
                      motion=MOTION_CCW if side < 0 else MOTION_CW, distance=length, de=0.0,
                      time=length / (feed / 60.0) if feed > 0 else 0.0)
             elif pending is not None:
-                # inside corner: cut the previous move where the two offset paths meet
-                meet = _crossing(last_path, this_path, new_start)
+                # inside corner: cut the previous move where the two offset paths meet; between
+                # lines rs274 backs the tool up its path by r / tan(half the corner) to get there
+                if last_path[0] == this_path[0] == "line":
+                    meet = start - last_dir * radius / math.tan((beta + math.pi) / 2)
+                else:
+                    meet = _crossing(last_path, this_path, new_start)
                 if meet is not None:
                     for r in (pending, *staying):
                         out[a][r], out[b][r] = meet[0], meet[1]
@@ -236,7 +265,8 @@ def compensate(op: "Operation", tools) -> None:
         if pending_dir is not None and pending is not None:
             done = np.array([out[a][pending], out[b][pending]]) - pending_start
             if float(done @ pending_dir) < -_TINY:  # the offset move would run backwards
-                op.diagnostics.report(int(t.line[row]), 1, "Straight feed in concave corner cannot be reached by "
+                kind = "traverse" if out["motion"][pending] == MOTION_RAPID else "feed"
+                op.diagnostics.report(int(t.line[row]), 1, f"Straight {kind} in concave corner cannot be reached by "
                                       "the tool without gouging", kind="machine")
         centre = (columns[ca][k], columns[cb][k]) if motion in (MOTION_CW, MOTION_CCW) else (np.nan, np.nan)
         pending, staying = emit(k, **{a: new_end[0], b: new_end[1], ca: centre[0], cb: centre[1]}), []
@@ -285,9 +315,7 @@ def _left(d: np.ndarray) -> np.ndarray:
 
 
 def _crossing(first: tuple, second: tuple, near: np.ndarray):
-    """Where two offset paths (lines or circles) cross, the crossing nearest ``near``."""
-    if first[0] == "line" and second[0] == "line":
-        return _meet(first[1], first[2], second[1], second[2])
+    """Where an offset line and circle or two circles cross, the crossing nearest ``near``."""
     if first[0] == "arc" and second[0] == "arc":
         points = _circles_cross(first[1], first[2], second[1], second[2])
     else:

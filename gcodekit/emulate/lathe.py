@@ -30,6 +30,9 @@ import copy
 import math
 import re
 from dataclasses import dataclass, field
+from typing import NamedTuple
+
+from ..preprocess.flow import PROFILE_TAG  # the comment that carries a cycle's profile
 
 TOLERANCE = 1e-6  # LinuxCNC's g7x tolerance
 #: rs274's ``equal`` (interp_internal.hh TOLERANCE_EQUAL): an arc to where the tool is is skipped
@@ -636,8 +639,6 @@ LATHE_CYCLES = {
     "lathe_rough_pockets": (71, 2), "lathe_face": (72, 0), "lathe_face_no_pockets": (72, 1),
     "lathe_face_pockets": (72, 2),
 }
-#: Comment the preprocess stage adds to a cycle block: the Q subroutine's blocks, ';'-separated
-PROFILE_TAG = "g7x profile:"
 _WORD = re.compile(r"([a-z])([-+]?(?:\d+\.?\d*|\.\d+))")
 _MOTIONS = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 _OTHER_MOTIONS = frozenset((5.0, 5.1, 5.2, 33.0, 33.1, 38.2, 38.3, 38.4, 38.5, 73.0, 74.0, 76.0, 80.0) +
@@ -667,8 +668,25 @@ def profile_of(comment: str | None) -> str | None:
     return comment.split(PROFILE_TAG, 1)[1].strip()
 
 
-def run_lathe_cycle(block: CycleBlock) -> tuple[complex, list[Move]]:
-    """The cycle point (where the first rapid goes) and the cycle's moves.
+def program_comment(comment: str | None) -> str | None:
+    """A cycle block's comment as the program wrote it, without the profile (None if that leaves nothing)."""
+    if not comment or PROFILE_TAG not in comment:
+        return comment
+    return comment.split(PROFILE_TAG, 1)[0].strip() or None
+
+
+class LatheCycle(NamedTuple):
+    """A lathe cycle's moves, in program coordinates (mm, ``z + x*1j``)."""
+
+    point: complex  # the cycle point, where the first rapid goes
+    moves: list[Move]
+    #: the profile's last point: rs274 leaves its current point there after reading the
+    #: profile, which matters to a G70 under cutter compensation (see ``compensation``)
+    profile_end: complex
+
+
+def run_lathe_cycle(block: CycleBlock) -> LatheCycle:
+    """The cycle point, the cycle's moves and where its profile ends.
 
     Raises
     ------
@@ -693,17 +711,18 @@ def run_lathe_cycle(block: CycleBlock) -> tuple[complex, list[Move]]:
     point = complex(z, x)
     blocks = _read_profile(block, point)
     segments = build_profile(point, blocks)
+    end = blocks[-1]["end"] if blocks else point
     if len(segments) <= 1:
-        return point, []
+        return LatheCycle(point, [], end)
     i = p.get("I", 1.0) * k
     if i <= 0:
         raise LatheCycleError("G7X error: I must be greater than zero.")
     d, e = p.get("D", 0.0) * k, p.get("E", 0.0) * k
     if cycle == 70:
-        return point, finish(segments, point, d, e, p.get("P", 1.0))
+        return LatheCycle(point, finish(segments, point, d, e, p.get("P", 1.0)), end)
     u = p.get("U", 0.0) * k / (2.0 if block.diameter else 1.0)
-    return point, rough(segments, point, turn=cycle == 72, subcycle=sub, d=d, i=i, r=p.get("R", 0.5) * k,
-                        u=u, w=p.get("W", 0.0) * k)
+    return LatheCycle(point, rough(segments, point, turn=cycle == 72, subcycle=sub, d=d, i=i,
+                                   r=p.get("R", 0.5) * k, u=u, w=p.get("W", 0.0) * k), end)
 
 
 def _read_profile(block: CycleBlock, start: complex) -> list[dict]:

@@ -113,6 +113,9 @@ class Machine:
         #: coordinates and units, X Y Z A B C (see :meth:`_after_probe`); None before one.
         self.probe_result: np.ndarray | None = None
         self.probes = 0  # probe moves run so far
+        #: (source line, profile end X Y Z in machine coordinates) of each G70 run under cutter
+        #: compensation, in order: the compensation pass needs it (see ``compensation``)
+        self.comp_profile_ends: list[tuple[int, np.ndarray]] = []
 
     # -- running ----------------------------------------------------------------
 

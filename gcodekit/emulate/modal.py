@@ -324,11 +324,14 @@ class ModalHandler:
         block = CycleBlock(name, params, profile_of(comment), complex(program[2], program[0]), s.units,
                            s.incremental, s.arc_incremental, s.diameter, s.plane, s.compensating)
         try:
-            point, moves = run_lathe_cycle(block)
+            point, moves, profile_end = run_lathe_cycle(block)
         except LatheCycleError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
             return MOTION_NONE, []
         offset = s.offset
+        if s.compensating:
+            self.machine.comp_profile_ends.append(
+                (line, np.array([profile_end.imag, program[1], profile_end.real]) + offset[:3]))
         here = program.copy()
         steps = []
         kinds = {"rapid": MOTION_RAPID, "feed": MOTION_LINEAR}

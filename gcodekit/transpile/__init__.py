@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..emulate.exporters import format_number
+from ..emulate.lathe import program_comment
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
 from ..parse.table import CYCLE_NAMES, MOTION_CYCLE, NAME_ID, NAMES
@@ -147,7 +148,9 @@ class Transpiler:
         polar = "@" in cmd.params or "^" in cmd.params or self._polar_rows[row]
         polar_stage = 2 if self._polar_rows[row] else 3
         if motion_row and (k >= 4 or (polar and k >= polar_stage)):
-            return self._from_waypoints(row, k, moving, comment)
+            # plain moves now: a lathe cycle's profile, carried in its comment, goes
+            kept = program_comment(cmd.comment)
+            return self._from_waypoints(row, k, moving, f" ({_paren(kept)})" if kept else "")
         if (k >= 1 and name in _UNITS) or (k >= 2 and name in _OFFSETS) or (k >= 4 and name in _DISTANCE) \
                 or (k >= 2 and name in _POLAR) or (k >= 4 and name in _COMP) or (k >= 6 and name in _CYCLE_MODES):
             return [f"({n} {_paren(str(cmd))} resolved)"] if k < 6 else []

@@ -73,10 +73,7 @@ _value _value_returned _task _call_level _remap_level
 """.split())
 
 #: Programs gcodekit knows it does not reproduce yet, and why.
-KNOWN_GAPS = {
-    "nc_files/lathe_g70_71_demo.ngc": "2 of 244 motions differ: the two rapids entering its G70 under G42.1 "
-                                      "(rs274's G70 reads its Q profile into the block it then moves with)",
-}
+KNOWN_GAPS: dict[str, str] = {}
 
 #: G-codes (as written, leading zeros dropped) gcodekit does not emulate yet.
 EXCLUDED_G: dict[str, str] = {}
