@@ -99,3 +99,40 @@ def test_g16_polar_moves_alike_at_every_stage(flavor, text):
         assert any("G16" in line for line in code_lines) == (k < 2), f"stage {k}"
         again = gcodekit.gcode_to_operation(out, flavor, plan=False, work_offsets={"G55": (100.0, 50.0, 0.0)})
         np.testing.assert_allclose(path_of(again), reference, atol=1e-3, equal_nan=True, err_msg=f"stage {k}")
+
+
+CYCLES_UNDER_OFFSETS = """G20 G17 G90
+G10 L2 P1 X0.4 Y-0.2 Z0.12
+G54 G0 X0 Y0 Z0.8
+G98 G81 X0.04 Y0.04 Z-0.12 R0.08 F4
+X0.16
+G99 G83 X0.24 Y0.08 Z-0.24 R0.04 Q0.08
+M3 S500
+G98 G87 X0.32 Y0.08 Z-0.04 R-0.3 I0.02 J0 K-0.2
+G80
+G0 Z0.8
+G18 G10 L2 P1 X0.28 Y0 Z-0.16
+O100 SUB
+  G0 X0.08 Z0
+  G1 X0.16 Z-0.2
+  G2 X0.24 Z-0.28 I0.08
+  G1 X0.32
+O100 ENDSUB
+G0 X0.4 Z0.2
+G70 Q100 X0.4 Z0.08 P2 D0.02
+G71 Q100 X0.4 Z0.08 D0.01 I0.04
+G0 X0.5 Z0.1
+G76 P0.05 Z-0.4 I-0.02 J0.004 K0.03
+M2
+"""
+
+
+def test_cycles_move_alike_at_every_stage():
+    """Cycle words (drilling's X Y Z R, a lathe cycle's point and profile, G76's) take the units and offsets."""
+    t = Transpiler(CYCLES_UNDER_OFFSETS, "linuxcnc")
+    reference = path_of(t.op)
+    assert not t.op.diagnostics.items
+    for k in STAGES:
+        again = gcodekit.gcode_to_operation(t.stage(k), "linuxcnc", plan=False)
+        assert not again.diagnostics.items, (k, again.diagnostics.items[:2])
+        np.testing.assert_allclose(path_of(again), reference, atol=1e-3, equal_nan=True, err_msg=f"stage {k}")

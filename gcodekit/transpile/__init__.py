@@ -37,11 +37,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..emulate.arcs import PLANES
 from ..emulate.exporters import format_number
-from ..emulate.lathe import program_comment
+from ..emulate.lathe import PROFILE_TAG, profile_of, program_comment
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
-from ..parse.table import CYCLE_NAMES, MOTION_CYCLE, NAME_ID, NAMES
+from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, NAME_ID, NAMES
+from .cycle_words import cycle_offset, lathe_defaults, length_words, level_words, rewrite_profile
 
 STAGES = tuple(range(7))
 STAGE_NAMES = ("expanded", "units", "offsets", "polar", "absolute", "cutter compensation", "canned cycles")
@@ -59,7 +61,6 @@ _POLAR = {"polar_on", "polar_off"}
 #: What the last stage keeps besides motion: dwell, tools, spindle, coolant, stops and the end.
 _KEPT = {"dwell", "tool_change", "spindle_cw", "spindle_ccw", "spindle_off", "coolant_mist", "coolant_flood",
          "coolant_off", "program_stop", "optional_stop", "program_end"}
-_LENGTH_WORDS = set("XYZUVWIJKRQ")
 
 
 class Transpiler:
@@ -90,6 +91,11 @@ class Transpiler:
         self._plane_words = bool(np.any(np.asarray(w["plane"])[arcs] != 17))
         self._polar_rows = mode_rows(self.op.table, "polar_on", "polar_off")  # G16: X radius, Y angle
         self._incremental_rows = mode_rows(self.op.table, "distance_incremental", "distance_absolute")  # G91
+        self._arc_absolute_rows = mode_rows(self.op.table, "arc_distance_absolute", "arc_distance_incremental")
+        # the last cycle command at or before each row (axis words alone repeat it)
+        cycles = np.isin(self.op.table.name, [NAME_ID[n] for n in CYCLE_NAMES])
+        self._last_cycle_row = np.maximum.accumulate(np.where(cycles, np.arange(len(cycles)), 0)) \
+            if len(cycles) else np.zeros(0, int)
         # G7: X words are diameters, except G10's (as rs274 reads them)
         self._diameter_rows = mode_rows(self.op.table, "diameter_mode", "radius_mode") & (
             self.op.table.name != NAME_ID["coordinate_data"])
@@ -140,7 +146,7 @@ class Transpiler:
         kind = Kind(int(t.kind[row]))
         cmd = t.command(row)
         n = f"N{cmd.line}"
-        comment = f" ({_paren(cmd.comment)})" if cmd.comment else ""
+        comment = self._comment(row, cmd, k)
         if kind == Kind.COMMENT:
             return [f"({_paren(cmd.comment or '')})"] if cmd.comment else []
         moving = self._waypoints(row)
@@ -148,9 +154,7 @@ class Transpiler:
         polar = "@" in cmd.params or "^" in cmd.params or self._polar_rows[row]
         polar_stage = 2 if self._polar_rows[row] else 3
         if motion_row and (k >= 4 or (polar and k >= polar_stage)):
-            # plain moves now: a lathe cycle's profile, carried in its comment, goes
-            kept = program_comment(cmd.comment)
-            return self._from_waypoints(row, k, moving, f" ({_paren(kept)})" if kept else "")
+            return self._from_waypoints(row, k, moving, comment)
         if (k >= 1 and name in _UNITS) or (k >= 2 and name in _OFFSETS) or (k >= 4 and name in _DISTANCE) \
                 or (k >= 2 and name in _POLAR) or (k >= 4 and name in _COMP) or (k >= 6 and name in _CYCLE_MODES):
             return [f"({n} {_paren(str(cmd))} resolved)"] if k < 6 else []
@@ -169,23 +173,47 @@ class Transpiler:
 
     def _words(self, row: int, cmd, k: int) -> str:
         """The command's own words, with units (stage 1+) and offsets (2+) resolved."""
-        w = self.op.waypoints
-        wp = self._waypoints(row)[-1]
-        scale = (25.4 if w["units"][wp] == 1 else 1.0) / self.unit if k >= 1 else 1.0
-        offset = self._offset(row) / self.unit if k >= 2 else np.zeros(6)
+        name = NAMES[int(self.op.table.name[row])]
+        scale = self._scale(row) if k >= 1 else 1.0
+        offset = self._offset(row) / self.unit if k >= 2 else np.zeros(3)
         absolute = not self._incremental(row)
+        lengths = length_words(name)
+        halved = "XU" if name in LATHE_CYCLE_NAMES else "X"  # a lathe cycle's U is a diameter too
+        plane = int(self.op.waypoints["plane"][self._waypoints(row)[-1]])
+        normal = "XYZ"[PLANES[plane][0][2]]
+        levels = level_words(name, plane) if name in CYCLE_NAMES and name not in LATHE_CYCLE_NAMES else ""
         words = [cmd.code] if cmd.code and not cmd.code.startswith(("#", "@")) else []
-        for letter, value in cmd.params.items():
+        params = cmd.params
+        if name in LATHE_CYCLE_NAMES and scale != 1.0:
+            params = {**params, **lathe_defaults(name, params)}
+        for letter, value in params.items():
             if letter in "@^" and k >= 3:
                 continue
             angle = letter == "Y" and self._polar_rows[row]  # G16: Y is an angle in degrees
-            v = value * scale if (letter in _LENGTH_WORDS or letter == "F") and not angle else value
-            if letter == "X" and k >= 1 and self._diameter_rows[row]:
+            v = value * scale if (letter in lengths or letter == "F") and not angle else value
+            if letter in halved and k >= 1 and self._diameter_rows[row]:
                 v /= 2.0
-            if absolute and letter in "XYZ" and k >= 2:
-                v += offset["XYZ".index(letter)]
+            if absolute and k >= 2 and (letter in "XYZ" or letter in levels):
+                v += offset["XYZ".index(normal if letter in levels else letter)]
             words.append(f"{letter}{format_number(v, self.precision)}")
         return " ".join(words + ([cmd.text] if cmd.text else []))
+
+    def _scale(self, row: int) -> float:
+        """Output length units per program unit at ``row``."""
+        return (25.4 if self.op.waypoints["units"][self._waypoints(row)[-1]] == 1 else 1.0) / self.unit
+
+    def _comment(self, row: int, cmd, k: int) -> str:
+        """The command's comment as written out; a lathe cycle's profile takes the stage's units and offsets."""
+        text = program_comment(cmd.comment)
+        profile = profile_of(cmd.comment)
+        if profile is not None and k < 6:  # the cycle line is still there: so must its profile be
+            if k >= 1:
+                offset = self._offset(row) / self.unit if k >= 2 else np.zeros(3)
+                profile = rewrite_profile(profile, scale=self._scale(row), halve=bool(self._diameter_rows[row]),
+                                          offset_x=offset[0], offset_z=offset[2],
+                                          arc_absolute=bool(self._arc_absolute_rows[row]), precision=self.precision)
+            text = f"{text} {PROFILE_TAG} {profile}" if text else f"{PROFILE_TAG} {profile}"
+        return f" ({_paren(text)})" if text else ""
 
     def _from_waypoints(self, row: int, k: int, points: np.ndarray, comment: str) -> list[str]:
         """Machine-frame moves of a command (stages 4-6; 2-3 for polar moves).
@@ -249,19 +277,26 @@ class Transpiler:
         return (f"G{plane} " if self._plane_words else "") + f"{code} {words}"
 
     def _offset(self, row: int) -> np.ndarray:
-        """Offset from program to machine coordinates in force at ``row`` (mm)."""
+        """Offset (mm, X Y Z) from program to machine coordinates in force at ``row``.
+
+        Read off the row's waypoints: a move with an absolute word v ends at
+        v*scale + offset (a cycle's words, see :func:`.cycle_words.cycle_offset`).
+        """
         w = self.op.waypoints
-        p = self._waypoints(row)[-1]
-        table = self.op.table
-        cmd = table.command(row)
-        position = np.array([w[a][p] for a in "xyzabc"])
-        # a row that gives an absolute axis value v ends at v*scale + offset
-        scale = 25.4 if w["units"][p] == 1 else 1.0
-        offset = np.zeros(6)
-        for i, a in enumerate("XYZ"):
-            if a in cmd.params and not self._incremental(row):
-                offset[i] = position[i] - cmd.params[a] * scale
-        return offset
+        points = self._waypoints(row)
+        cmd = self.op.table.command(row)
+        if self._incremental(row):
+            return np.zeros(3)
+        scale = 25.4 if w["units"][points[-1]] == 1 else 1.0
+        positions = np.column_stack([np.asarray(w[a])[points] for a in "xyz"])
+        name = NAMES[int(self.op.table.name[row])]
+        if name in CYCLE_NAMES or int(self.op.table.motion[row]) == MOTION_CYCLE:
+            if name not in CYCLE_NAMES:  # axis words alone, repeating the cycle in force
+                name = NAMES[int(self.op.table.name[self._last_cycle_row[row]])]
+            feeds = np.asarray(w["motion"])[points] == 2
+            return cycle_offset(name, cmd.params, scale, positions, feeds, int(w["plane"][points[-1]]))
+        return np.array([positions[-1, i] - cmd.params[a] * scale if a in cmd.params else 0.0
+                         for i, a in enumerate("XYZ")])
 
     def _incremental(self, row: int) -> bool:
         """G91 in force at ``row`` (from the distance-mode commands up to it)."""
