@@ -32,7 +32,7 @@ import re
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
-from ..preprocess.flow import PROFILE_TAG  # the comment that carries a cycle's profile
+from ..parse.table import PROFILE_TAG
 
 TOLERANCE = 1e-6  # LinuxCNC's g7x tolerance
 #: rs274's ``equal`` (interp_internal.hh TOLERANCE_EQUAL): an arc to where the tool is is skipped

@@ -35,6 +35,10 @@ CYCLE_NAMES = ("cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_pe
                    "lathe_finish", "lathe_rough", "lathe_rough_no_pockets", "lathe_rough_pockets",
                    "lathe_face", "lathe_face_no_pockets", "lathe_face_pockets"))
 
+#: The comment the preprocess stage gives a lathe cycle's line: its Q subroutine's blocks,
+#: ';'-separated, so the emulator runs the cycle without the subroutine (gcodekit.emulate.lathe)
+PROFILE_TAG = "g7x profile:"
+
 _SPARSE_BELOW = 0.02  # a parameter present in fewer rows than this is kept sparse
 
 

@@ -50,6 +50,7 @@ from typing import TYPE_CHECKING, Iterable, Iterator, Sequence
 
 from gcodekit.errors import Diagnostics, GcodeError, GcodeLimitError, did_you_mean
 from gcodekit.preprocess.expressions import Node, compact, evaluate, expression_error, parse_value
+from gcodekit.parse.table import PROFILE_TAG
 from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, format_number
 
 if TYPE_CHECKING:
@@ -80,9 +81,6 @@ _MAYBE_FLOW_M = re.compile(r"[mM][ \t0]*(?:2|3[ \t]*0|9[ \t]*[89])")
 # Cheap test for a line that may hold a lathe cycle G70-G72
 _MAYBE_LATHE_CYCLE = re.compile(r"[gG][ \t0]*7[ \t]*[012]")
 _LATHE_CYCLES = frozenset((70.0, 71.0, 71.1, 71.2, 72.0, 72.1, 72.2))
-#: The comment a lathe cycle's line gets: its Q subroutine's blocks, ';'-separated (read by
-#: gcodekit.emulate.lathe, so the cycle runs without the subroutine)
-PROFILE_TAG = "g7x profile:"
 # LinuxCNC subroutine file names: lower-case letters, digits, '-' and '_'.
 _FILE_NAME = re.compile(r"[a-z0-9_-]+")
 _CONDITIONS = ("if", "elseif", "while", "repeat")

@@ -39,10 +39,10 @@ import numpy as np
 
 from ..emulate.arcs import PLANES
 from ..emulate.exporters import format_number
-from ..emulate.lathe import PROFILE_TAG, profile_of, program_comment
+from ..emulate.lathe import profile_of, program_comment
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
-from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, NAME_ID, NAMES
+from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, NAME_ID, NAMES, PROFILE_TAG
 from .cycle_words import cycle_offset, lathe_defaults, length_words, level_words, rewrite_profile
 
 STAGES = tuple(range(7))
