@@ -103,3 +103,18 @@ def test_axis_words_alone_continue_in_the_cycles_last_mode() -> None:
                                                machine="linuxcnc", plan=False)
     errors = [(d.line, d.message) for d in after_finish.diagnostics if d.severity == "error"]
     assert errors == [(9, "R i j k words all missing for arc")]
+
+
+def test_cycle_arcs_are_measured_along_the_arc() -> None:
+    """A quarter circle of radius 2 in a G70 profile is pi long and cut at F, not at the rapid rate;
+    axis words with K after it cut the next arc of the cycle's mode (own golden case lathe_arc_after_cycle)."""
+    text = ("G18 G21 F120\nO100 SUB\nG0 X2 Z0\nG3 X4 Z-2 K-2\nO100 ENDSUB\nG0 X6 Z2\n"
+            "G70 Q100 X6 Z2\nX6 Z-4 K-2\nM2\n")
+    op = gcodekit.gcode_to_operation(text, machine="linuxcnc", plan=False)
+    w = op.waypoints
+    arcs = np.flatnonzero(np.asarray(w["motion"]) == 4)  # G3
+    assert len(arcs) == 2
+    for i in arcs:  # both quarter circles of radius 2
+        assert w["distance"][i] == pytest.approx(math.pi)
+        assert w["time"][i] == pytest.approx(math.pi / 120 * 60)  # seconds at 120 mm/min
+    assert (w["x"][arcs[1]], w["z"][arcs[1]], w["cx"][arcs[1]], w["cz"][arcs[1]]) == (6.0, -4.0, 4.0, -4.0)

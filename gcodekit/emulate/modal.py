@@ -18,6 +18,7 @@ import numpy as np
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_RAPID,
                            MOTION_THREAD, NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
 from ..parse.commands import Kind
+from .arcs import PLANES, arc_length, center_from_radius, sweep
 from .cycles import CYCLES, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
@@ -309,13 +310,34 @@ class ModalHandler:
         """Axis words alone after G70-G72: a move in the mode of the cycle's last move (rs274's
         ``motion_mode`` after the cycle ran its moves through ``convert_straight``/``convert_arc``)."""
         motion = self._lathe_motion
-        if motion in (MOTION_CW, MOTION_CCW):
-            message = ("R i j k words all missing for arc" if not any(k in params for k in "IJKR") else
-                       "an arc in the mode a lathe cycle left in force is not emulated; write G2 or G3")
-            self.machine.diagnostics.report(line, 1, message, kind="machine")
+        arc = motion in (MOTION_CW, MOTION_CCW)
+        if arc and not any(k in params for k in "IJKR"):
+            self.machine.diagnostics.report(line, 1, "R i j k words all missing for arc", kind="machine")
             return MOTION_NONE
+        before = self.state.position.copy()
         self._move_to(self._program_target(params), params)
+        if arc:
+            self._last_centre = self._arc_centre(before, params, motion == MOTION_CW, line)
         return motion or MOTION_LINEAR
+
+    def _arc_centre(self, before: np.ndarray, params: dict, clockwise: bool, line: int) -> tuple:
+        """Centre (machine X Y Z, the plane's normal NaN) of an arc from ``before`` to the position, by I/J/K or R."""
+        s = self.state
+        (f, g, _), (l1, l2) = PLANES[s.plane]
+        p0, p1 = before[[f, g]], s.position[[f, g]]
+        if "R" in params:
+            centre, reach = center_from_radius(p0[None], p1[None], np.array([params["R"] * s.units]),
+                                               np.array([clockwise]))
+            if reach[0] > (0.005 if s.units == 1.0 else 0.0005 * 25.4):
+                self.machine.diagnostics.report(line, 1, "arc radius too small to reach the end point",
+                                                kind="machine")
+            in_plane = centre[0]
+        else:
+            words = np.array([params.get(l1, 0.0), params.get(l2, 0.0)]) * s.units
+            in_plane = p0 + words if s.arc_incremental else words + s.offset[[f, g]]
+        centre = np.full(3, np.nan)
+        centre[[f, g]] = in_plane
+        return tuple(centre)
 
     def _lathe_cycle(self, name: str, params: dict, comment: str | None, line: int) -> tuple[int, list[Waypoint]]:
         """G70-G72: the moves of a lathe cycle become waypoints (see :mod:`.lathe`)."""
@@ -592,9 +614,9 @@ class ModalHandler:
 
     def _fill_passing(self, w: Waypoint, before: np.ndarray) -> None:
         point = np.array([w.values[k] for k in AXES.lower()])
-        distance = float(np.linalg.norm((point - before)[:3]))
         motion = int(w.values.get("motion", MOTION_RAPID))
-        rate = w.values["feed"] if "feed" in w.values and motion == MOTION_LINEAR else self._rate(motion)
+        distance = self._length(before, point, motion, [w.values.get(k, np.nan) for k in ("cx", "cy", "cz")])
+        rate = w.values["feed"] if "feed" in w.values and motion != MOTION_RAPID else self._rate(motion)
         dwell = w.values.pop("dwell", 0.0)
         w.values.update(distance=distance, time=(distance / (rate / 60.0) if distance and rate > 0 else 0.0) + dwell,
                         de=0.0)
@@ -604,14 +626,25 @@ class ModalHandler:
     def _rate(self, motion: int) -> float:
         """Feed of a move made by a special command, mm/min."""
         s = self.state
-        return s.feed if (motion == MOTION_LINEAR or self.machine.rapid_is_feed) else self.machine.config.rapid_feed
+        feeding = motion in (MOTION_LINEAR, MOTION_CW, MOTION_CCW) or self.machine.rapid_is_feed
+        return s.feed if feeding else self.machine.config.rapid_feed
+
+    def _length(self, before: np.ndarray, point: np.ndarray, motion: int, centre) -> float:
+        """Path length of a move made by a special command: the chord, or the arc round ``centre``."""
+        (f, g, h), _ = PLANES[self.state.plane]
+        centre = np.asarray(centre, float)
+        if motion not in (MOTION_CW, MOTION_CCW) or np.isnan(centre[[f, g]]).any():
+            return float(np.linalg.norm((point - before)[:3]))
+        p0, p1, c = before[[f, g]][None], point[[f, g]][None], centre[[f, g]][None]
+        angle = sweep(p0, p1, c, np.array([motion == MOTION_CW]), np.ones(1))
+        return float(arc_length(np.hypot(*(p0 - c).T), angle, np.array([point[h] - before[h]]))[0])
 
     def _write(self, out: dict, row: int, before: np.ndarray, motion: int, de: float = 0.0,
                feed: float | None = None) -> None:
         s = self.state
         for k, v in zip(AXES.lower(), s.position):
             out[k][row] = v
-        distance = float(np.linalg.norm((s.position - before)[:3]))
+        distance = self._length(before, s.position, motion, self._last_centre)
         rate = self._rate(motion) if feed is None else feed
         path = distance or abs(de)
         out["distance"][row] = distance
