@@ -43,7 +43,7 @@ from ..emulate.lathe import profile_of, program_comment
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
 from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, NAME_ID, NAMES, PROFILE_TAG
-from .cycle_words import cycle_offset, lathe_defaults, length_words, level_words, rewrite_profile
+from .cycle_words import cycle_offset, diameter_words, lathe_defaults, length_words, level_words, rewrite_profile
 
 STAGES = tuple(range(7))
 STAGE_NAMES = ("expanded", "units", "offsets", "polar", "absolute", "cutter compensation", "canned cycles")
@@ -178,7 +178,7 @@ class Transpiler:
         offset = self._offset(row) / self.unit if k >= 2 else np.zeros(3)
         absolute = not self._incremental(row)
         lengths = length_words(name)
-        halved = "XU" if name in LATHE_CYCLE_NAMES else "X"  # a lathe cycle's U is a diameter too
+        halved = diameter_words(name)
         plane = int(self.op.waypoints["plane"][self._waypoints(row)[-1]])
         normal = "XYZ"[PLANES[plane][0][2]]
         levels = level_words(name, plane) if name in CYCLE_NAMES and name not in LATHE_CYCLE_NAMES else ""
@@ -288,15 +288,17 @@ class Transpiler:
         if self._incremental(row):
             return np.zeros(3)
         scale = 25.4 if w["units"][points[-1]] == 1 else 1.0
+        words = dict(cmd.params)
+        if "X" in words and self._diameter_rows[row]:
+            words["X"] /= 2.0  # G7: the X word is a diameter
         positions = np.column_stack([np.asarray(w[a])[points] for a in "xyz"])
         name = NAMES[int(self.op.table.name[row])]
         if name in CYCLE_NAMES or int(self.op.table.motion[row]) == MOTION_CYCLE:
             if name not in CYCLE_NAMES:  # axis words alone, repeating the cycle in force
                 name = NAMES[int(self.op.table.name[self._last_cycle_row[row]])]
             feeds = np.asarray(w["motion"])[points] == 2
-            return cycle_offset(name, cmd.params, scale, positions, feeds, int(w["plane"][points[-1]]))
-        return np.array([positions[-1, i] - cmd.params[a] * scale if a in cmd.params else 0.0
-                         for i, a in enumerate("XYZ")])
+            return cycle_offset(name, words, scale, positions, feeds, int(w["plane"][points[-1]]))
+        return np.array([positions[-1, i] - words[a] * scale if a in words else 0.0 for i, a in enumerate("XYZ")])
 
     def _incremental(self, row: int) -> bool:
         """G91 in force at ``row`` (from the distance-mode commands up to it)."""

@@ -13,7 +13,8 @@ which waypoint shows the offset depend on the cycle:
   the profile, carried in the line's comment, is rewritten the same way,
   and the lengths G71/G72 default in program units (I 1, R 0.5) are written
   out when the units change;
-* G76 threading: ``P`` (the pitch) is a length; X/Z are where it ends.
+* G76 threading: ``P`` (the pitch) is a length, I/J/K are diameters in G7
+  like X; X/Z are where it ends.
 """
 
 from __future__ import annotations
@@ -66,6 +67,11 @@ def cycle_offset(name: str, params: dict, scale: float, points: np.ndarray, feed
         if letter in params:
             offset[axis] = source[axis][axis] - params[letter] * scale
     return offset
+
+
+def diameter_words(name: str) -> str:
+    """Words that are diameters in G7 (lathe diameter mode), as rs274 halves them."""
+    return "XU" if name in LATHE_CYCLE_NAMES else "XIJK" if name == "cycle_thread" else "X"
 
 
 def level_words(name: str, plane: int) -> str:
