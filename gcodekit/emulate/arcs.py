@@ -21,6 +21,12 @@ PLANE_CODES = (17, 18, 19)
 TWO_PI = 2.0 * np.pi
 
 
+def reach_tolerance(units: float) -> float:
+    """How far (mm) an R-form arc may fall short of its end point before LinuxCNC refuses it
+    (0.005 mm in G21, 0.0005 in in G20; ``units`` is mm per program unit)."""
+    return 0.005 if units == 1.0 else 0.0005 * 25.4
+
+
 def center_from_radius(start: np.ndarray, end: np.ndarray, radius: np.ndarray, clockwise: np.ndarray):
     """In-plane centers of arcs given by radius (LinuxCNC ``arc_data_r``).
 

@@ -233,7 +233,9 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
         # move starts where the tool is
         if gap > _TINY and abs(beta) > CONCAVE_CORNER:
             if beta > 0:
-                for r in (pending, *staying):  # the moves before end where the tool is (a no-op but after a G70)
+                # rs274 ends the queued moves where the tool is: they end there already,
+                # except a G70's first rapid and the approach queued before it
+                for r in (pending, *staying):
                     if r is not None:
                         out[a][r], out[b][r] = start[0], start[1]
             if beta > 0 and motion == MOTION_RAPID:

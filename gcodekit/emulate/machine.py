@@ -411,8 +411,7 @@ class Machine:
         if by_radius.any():
             c, reach = arcs.center_from_radius(p0[by_radius], p1[by_radius], r_word[by_radius], clockwise[by_radius])
             center[by_radius] = c
-            tolerance = 0.005 if s.units == 1.0 else 0.0005 * 25.4
-            for i in np.flatnonzero(by_radius)[reach > tolerance][:20]:
+            for i in np.flatnonzero(by_radius)[reach > arcs.reach_tolerance(s.units)][:20]:
                 self.diagnostics.report(int(t.line[rows[i]]), 1, "arc radius too small to reach the end point",
                                         kind="machine")
         turns = np.nan_to_num(_take(t, "P", rows), nan=1.0)

@@ -18,7 +18,7 @@ import numpy as np
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_RAPID,
                            MOTION_THREAD, NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
 from ..parse.commands import Kind
-from .arcs import PLANES, arc_length, center_from_radius, sweep
+from .arcs import PLANES, arc_length, center_from_radius, reach_tolerance, sweep
 from .cycles import CYCLES, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
@@ -328,7 +328,7 @@ class ModalHandler:
         if "R" in params:
             centre, reach = center_from_radius(p0[None], p1[None], np.array([params["R"] * s.units]),
                                                np.array([clockwise]))
-            if reach[0] > (0.005 if s.units == 1.0 else 0.0005 * 25.4):
+            if reach[0] > reach_tolerance(s.units):
                 self.machine.diagnostics.report(line, 1, "arc radius too small to reach the end point",
                                                 kind="machine")
             in_plane = centre[0]
