@@ -7,10 +7,15 @@ tool off it by the tool radius, after the rules of LinuxCNC's interpreter
 * the first move after G41/G42 (the entry) runs to its programmed end
   shifted by the radius to the left (G41) or right (G42) of that move: a
   line straight there, an arc on a centre moved along its end radius;
+* a negative diameter compensates on the other side;
 * every later move is shifted the same way (an arc's radius grows or shrinks
   by the tool radius); at an outside corner the tool rolls round the
   programmed corner on an arc of the tool radius, at an inside corner the
-  previous move is cut short where the two shifted paths meet;
+  previous move is cut short where the two shifted paths meet, worked out
+  from the corner's angle as rs274 does; corners are measured from -90 to
+  270 degrees, so a path turning back on itself within the tolerance rolls
+  round the corner, unless the tool would end up between the two moves
+  (atop an "h" or an "m" shape, rs274's special cases);
 * a corner turning less than 0.05 rad (rs274's ``TOLERANCE_CONCAVE_CORNER``)
   either way gets neither: the move starts where the tool is; a rapid
   round an outside corner goes straight to where the roll would end (there
@@ -78,7 +83,8 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
     moved = (0.0, 0.0)  # the shift of the rows emitted now: ``lathe`` from the entry move to the exit move
     lathe_rows: list[tuple[int, float, float, int]] = []  # (index in `out`, shift along a, along b, plane)
     last_dir = None  # tangent at the end of the previous compensated move
-    last_path = None  # its offset path: ("line", point, direction) or ("arc", centre, radius)
+    # its offset path: ("line", point, direction) or ("arc", centre, radius, ccw, tool inside the arc)
+    last_path = None
     last_corner = None  # programmed end of the previous move
     pending = None  # index in `out` of the previous compensated waypoint
     staying: list[int] = []  # later rows that end where `pending` does (no move in the plane)
@@ -117,6 +123,8 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
                             number = int(params.get("D", columns["tool"][k]))
                             radius = tools[number].diameter / 2.0 if number in tools else 0.0
                             orientation = tools[number].orientation if number in tools else 0
+                        if radius < 0:  # rs274: a negative diameter compensates on the other side
+                            radius, side = -radius, -side
                         plane = int(columns["plane"][k])
                         lathe = _lathe_shift(orientation, radius) if plane == 18 else (0.0, 0.0)
                     elif not new and side:
@@ -214,7 +222,7 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
             pending, staying = emit(k, **{a: new_end[0], b: new_end[1], ca: entry_center[0], cb: entry_center[1]}), []
             pending_start, pending_dir = start, None
             mode, last_dir, last_corner = "on", out_dir, end
-            last_path = ("arc", entry_center, float(np.hypot(*(new_end - entry_center))))
+            last_path = ("arc", entry_center, float(np.hypot(*(new_end - entry_center))), ccw, grow < 0)
             continue
         if mode == "entry":
             # comp1: straight to the end shifted off the entry move's own direction
@@ -225,45 +233,61 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
             mode, last_dir, last_corner = "on", _unit(chord), end
             last_path = ("line", shifted, _unit(chord))
             continue
-        # beta: how far the path turns away from the tool's side (> 0: an outside corner)
+        # beta: how far the path turns away from the tool's side (> 0: an outside corner),
+        # from -90 to 270 degrees as rs274 measures it
         beta = -side * math.atan2(last_dir[0] * in_dir[1] - last_dir[1] * in_dir[0], float(last_dir @ in_dir))
-        this_path = ("arc", center, new_r1) if motion in (MOTION_CW, MOTION_CCW) else ("line", new_start, in_dir)
+        if beta < -math.pi / 2:
+            beta += 2 * math.pi
+        arc = motion in (MOTION_CW, MOTION_CCW)
+        this_path = ("arc", center, new_r1, ccw, grow < 0) if arc else ("line", new_start, in_dir)
+        # turning back on itself within the tolerance, rs274 keeps the tool on its side of
+        # both moves (atop an "h" or an "m") when an arc has the tool outside, or before it
+        reversal = (abs(beta - math.pi) < CONCAVE_CORNER and grow > 0) if arc else \
+            (beta > math.pi - CONCAVE_CORNER and last_path[0] == "arc" and last_path[4])
+        inside = beta < -CONCAVE_CORNER or beta > math.pi + CONCAVE_CORNER or reversal
         gap = np.hypot(*(new_start - start))
         # within CONCAVE_CORNER of straight on, rs274 neither rolls round nor trims: the
         # move starts where the tool is
-        if gap > _TINY and abs(beta) > CONCAVE_CORNER:
-            if beta > 0:
+        if gap > _TINY and (inside or beta > CONCAVE_CORNER):
+            if not inside:
                 # rs274 ends the queued moves where the tool is: they end there already,
                 # except a G70's first rapid and the approach queued before it
                 for r in (pending, *staying):
                     if r is not None:
                         out[a][r], out[b][r] = start[0], start[1]
-            if beta > 0 and motion == MOTION_RAPID:
+            if not inside and motion == MOTION_RAPID:
                 # no rapid arc: rs274 traverses straight to where the roll would end
                 whole = float(columns["distance"][k])  # at the rapid's own speed
                 emit(k, **{a: new_start[0], b: new_start[1]}, distance=float(gap), de=0.0,
                      time=float(columns["time"][k]) * gap / whole if whole > 0 else 0.0)
-            elif beta > 0:  # outside corner: roll round the programmed corner
+            elif not inside:  # outside corner: roll round the programmed corner
                 length = radius * _angle(start, new_start, programmed_start)
                 feed = float(columns["feed"][k])
                 emit(k, **{a: new_start[0], b: new_start[1], ca: programmed_start[0], cb: programmed_start[1]},
                      motion=MOTION_CCW if side < 0 else MOTION_CW, distance=length, de=0.0,
                      time=length / (feed / 60.0) if feed > 0 else 0.0)
             elif pending is not None:
-                # inside corner: cut the previous move where the two offset paths meet; between
-                # lines rs274 backs the tool up its path by r / tan(half the corner) to get there
-                if last_path[0] == this_path[0] == "line":
+                # inside corner: cut the previous move where the two offset paths meet, worked
+                # out as rs274 does (which also picks the side when the path turns back on itself)
+                kinds = "Arc" if last_path[0] == "arc" else "Straight", "arc" if arc else "straight"
+                problem = f"{kinds[0]} to {kinds[1]} motion makes a corner the compensated tool can't fit in " \
+                    "without gouging"
+                if last_path[0] == "line" and not arc:
                     meet = start - last_dir * radius / math.tan((beta + math.pi) / 2)
+                elif last_path[0] == "line":
+                    heading = math.atan2(*(start - programmed_start)[::-1]) - side * math.pi / 2
+                    meet = _line_to_arc_corner(heading, beta, this_path, r1, radius)
+                    problem = "Arc move in concave corner cannot be reached by the tool without gouging"
+                elif not arc:
+                    meet = _arc_to_line_corner(last_path, programmed_start, math.atan2(in_dir[1], in_dir[0]), radius)
                 else:
-                    meet = _crossing(last_path, this_path, new_start)
+                    meet = _arc_to_arc_corner(last_path, this_path)
                 if meet is not None:
                     for r in (pending, *staying):
                         out[a][r], out[b][r] = meet[0], meet[1]
                     new_start = meet
                 else:
-                    kinds = "Arc" if last_path[0] == "arc" else "Straight", "arc" if this_path[0] == "arc" else "straight"
-                    op.diagnostics.report(int(t.line[row]), 1, f"{kinds[0]} to {kinds[1]} motion makes a corner the "
-                                          "compensated tool can't fit in without gouging", kind="machine")
+                    op.diagnostics.report(int(t.line[row]), 1, problem, kind="machine")
         if pending_dir is not None and pending is not None:
             done = np.array([out[a][pending], out[b][pending]]) - pending_start
             if float(done @ pending_dir) < -_TINY:  # the offset move would run backwards
@@ -316,36 +340,55 @@ def _left(d: np.ndarray) -> np.ndarray:
     return np.array([-d[1], d[0]])
 
 
-def _crossing(first: tuple, second: tuple, near: np.ndarray):
-    """Where an offset line and circle or two circles cross, the crossing nearest ``near``."""
-    if first[0] == "arc" and second[0] == "arc":
-        points = _circles_cross(first[1], first[2], second[1], second[2])
+def _line_to_arc_corner(heading: float, beta: float, arc: tuple, arc_radius: float,
+                        radius: float) -> np.ndarray | None:
+    """Where the tool leaves a line for an ``arc`` path at an inside corner (rs274's ``convert_arc_comp2``).
+
+    ``heading``: the line's direction (radians); ``beta``: the corner's turn
+    (see ``compensate``); ``arc_radius``: the programmed one.  None when the
+    tool cannot reach the corner.
+    """
+    _, centre, _, ccw, inside = arc
+    across = arc_radius * math.sin(beta - math.pi / 2)
+    if inside:
+        reach, towards = arc_radius - radius, across + radius
     else:
-        line, circle = (first, second) if first[0] == "line" else (second, first)
-        points = _line_circle_cross(line[1], line[2], circle[1], circle[2])
-    return min(points, key=lambda p: float(np.hypot(*(p - near))), default=None)
+        reach, towards = arc_radius + radius, across - radius
+    if abs(towards / reach) > 1.0:
+        return None
+    turn = math.asin(towards / reach) if ccw else -math.asin(towards / reach)
+    angle = heading + turn if inside else heading + math.pi - turn
+    return centre + reach * np.array([math.cos(angle), math.sin(angle)])
 
 
-def _line_circle_cross(p: np.ndarray, d: np.ndarray, c: np.ndarray, r: float) -> list[np.ndarray]:
-    f = p - c
-    b, cc = float(f @ d), float(f @ f) - r * r  # d is a unit vector
-    disc = b * b - cc
-    if disc < 0:
-        return []
-    root = math.sqrt(disc)
-    return [p + (-b - root) * d, p + (-b + root) * d]
+def _arc_to_line_corner(arc: tuple, corner: np.ndarray, heading: float, radius: float) -> np.ndarray | None:
+    """Where the tool leaves an ``arc`` path for a line heading ``heading`` from the programmed
+    ``corner`` (rs274's ``convert_straight_comp2``); None when it cannot fit."""
+    _, centre, arc_radius, ccw, inside = arc
+    normal = heading + (math.pi / 2 if ccw else -math.pi / 2)
+    to_centre = math.atan2(*(centre - corner)[::-1])
+    programmed = arc_radius + radius if inside else arc_radius - radius
+    across = programmed * math.cos(normal - to_centre) + (-radius if inside else radius)
+    if abs(across / arc_radius) > 1.0:
+        return None
+    turn = math.acos(across / arc_radius)
+    angle = normal + math.pi + (turn if ccw != inside else -turn)
+    return centre + arc_radius * np.array([math.cos(angle), math.sin(angle)])
 
 
-def _circles_cross(c0: np.ndarray, r0: float, c1: np.ndarray, r1: float) -> list[np.ndarray]:
-    gap = c1 - c0
-    dist = float(np.hypot(*gap))
-    if dist < _TINY or dist > r0 + r1 or dist < abs(r0 - r1):
-        return []
-    along = (r0 * r0 - r1 * r1 + dist * dist) / (2 * dist)
-    half = math.sqrt(max(r0 * r0 - along * along, 0.0))
-    base = c0 + gap * along / dist
-    across = _left(gap / dist) * half
-    return [base + across, base - across]
+def _arc_to_arc_corner(first: tuple, second: tuple) -> np.ndarray | None:
+    """Where the tool leaves the ``first`` arc path for the ``second`` (rs274's ``convert_arc_comp2``)."""
+    _, c0, r0, _, inside = first
+    _, c1, r1, ccw, _ = second
+    apart = float(np.hypot(*(c1 - c0)))
+    if r0 == 0 or apart == 0:
+        return None
+    cosine = (r0 * r0 + apart * apart - r1 * r1) / (2 * r0 * apart)
+    if abs(cosine) > 1.0:
+        return None
+    pullback = math.acos(cosine) if inside == ccw else -math.acos(cosine)
+    angle = math.atan2(*(c1 - c0)[::-1]) + pullback
+    return c0 + r0 * np.array([math.cos(angle), math.sin(angle)])
 
 
 def _meet(p: np.ndarray, d: np.ndarray, q: np.ndarray, e: np.ndarray):
