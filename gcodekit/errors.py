@@ -96,6 +96,7 @@ class Diagnostics:
         self.mode = check_choice("mode", mode, MODES)
         self.limit = limit
         self.items: list[Diagnostic] = []
+        self._kinds: list[str] = []  # of each item: which GcodeError it raises as
         self.dropped = 0
         #: Line numbers standing for lines of other files (subroutine files): number -> (file, line)
         self.elsewhere: dict[int, tuple[str, int]] = {}
@@ -127,6 +128,7 @@ class Diagnostics:
             self._first_error = (kind, diag)
         if len(self.items) < self.limit:
             self.items.append(diag)
+            self._kinds.append(kind)
         else:
             self.dropped += 1
         return diag
@@ -136,7 +138,7 @@ class Diagnostics:
 
     def extend(self, diagnostics: Iterable[Diagnostic]) -> None:
         for d in diagnostics:
-            self.report(d.line, d.column, d.message, d.text, severity=d.severity)
+            self.report(d.line, d.column, d.message, d.text, severity=d.severity, file=d.file)
 
     @property
     def has_error(self) -> bool:
@@ -148,6 +150,10 @@ class Diagnostics:
         if self._first_error is not None:
             kind, diag = self._first_error
             raise _ERROR_TYPES[kind](diag.message, diag)
+
+    def raise_item(self, k: int) -> None:
+        """Raise diagnostic ``k`` of :attr:`items` as the error it was reported as."""
+        raise _ERROR_TYPES[self._kinds[k]](self.items[k].message, self.items[k])
 
     @property
     def errors(self) -> list[Diagnostic]:

@@ -185,7 +185,10 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         config = dataclasses.replace(config, **firmware_options(config.planner, machine_config))
     diagnostics = Diagnostics(program.name, mode)
     parser = GcodeParser(fl, diagnostics)
-    m = Machine(config, diagnostics, rapid_is_feed=fl.rapid_is_feed, initial_units=fl.units,
+    # strict mode raises the machine's first error once the program has run (see _raise_first_run)
+    machine_diagnostics = Diagnostics(program.name, "lenient") if mode == "strict" else diagnostics
+    machine_diagnostics.elsewhere = diagnostics.elsewhere
+    m = Machine(config, machine_diagnostics, rapid_is_feed=fl.rapid_is_feed, initial_units=fl.units,
                 initial_extrusion=fl.extrusion, rs274_blocks=fl.block_split == "modal",
                 polar_incremental_only=fl.polar_incremental_only)
     tables, waypoints, n_lines = [], [], 0
@@ -198,8 +201,12 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         waypoints.append(m.run(table))
         n_lines += lines
 
-    for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate)):
-        emulate(blocks, lines)
+    reading_error = None
+    try:
+        for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate)):
+            emulate(blocks, lines)
+    except GcodeError as exc:  # strict mode: raised below unless a line run before it failed
+        reading_error = exc
     if bar is not None:
         bar.close()
     cls = OPERATION_CLASSES[config.process]
@@ -207,16 +214,20 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     table = CommandTable.concat(tables) if tables else _empty_table(parser, program)
     if not tables:
         waypoints, sizes = [m.run(table)], [0]
-    if fl.percent_delimiter and program.path is not None and not program.preprocessed:
-        _check_program_end(program, table, n_lines, diagnostics)
+    if fl.percent_delimiter and program.path is not None and not program.preprocessed and reading_error is None:
+        _check_program_end(program, table, n_lines, machine_diagnostics)  # rs274 finds it after the last line ran
     op = cls(table, _concat_waypoints(waypoints, sizes), file=program.name,
-             flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
+             flavor=fl, machine=config, diagnostics=machine_diagnostics, n_lines=n_lines)
     del tables, waypoints
     release_freed_memory()  # the reader's per-chunk garbage, before the planner's arrays
     from .emulate.compensation import compensate, uses_compensation
 
     if uses_compensation(op):
         compensate(op, m.tools, m.comp_profile_ends)
+    if mode == "strict":
+        _raise_first_run(op, program, reading_error)
+        diagnostics.extend(machine_diagnostics)  # its warnings
+        op.diagnostics = diagnostics
     if plan and config.planner:
         from .emulate.planners import planner_settings, run_planner
 
@@ -413,6 +424,33 @@ class _MachineStop(Exception):
             return read_source_lines(lines, flavor, diagnostics)
         except _MachineStop as stop:
             raise stop.error from None
+
+
+def _raise_first_run(op: Operation, program: Program, reading_error: GcodeError | None) -> None:
+    """Strict mode: raise the error of the line that ran first, as rs274 stops there.
+
+    The machine's errors (some found only by the compensation pass, after
+    the whole program ran) are ranked by the first row of their line; the
+    reader's or parameter stage's error came after every line emulated.
+    """
+    found = op.diagnostics
+    errors = [k for k, d in enumerate(found.items) if d.severity == "error"]
+    if not errors:
+        if reading_error is not None:
+            raise reading_error
+        return
+    quote_diagnostics(found, program)
+    lines = op.table.line
+    numbers, first_rows = np.unique(lines, return_index=True)
+    first_row = dict(zip(numbers.tolist(), first_rows.tolist()))
+    raw = {key: number for number, key in found.elsewhere.items()}  # (file, line) -> the number rows carry
+
+    def ran_at(k: int) -> tuple[int, int]:
+        d = found.items[k]
+        number = d.line if d.file == found.file else raw.get((d.file, d.line), -1)
+        return first_row.get(number, len(lines)), k
+
+    found.raise_item(min(errors, key=ran_at))
 
 
 def _check_program_end(program: Program, table: CommandTable, n_lines: int, diagnostics: Diagnostics) -> None:

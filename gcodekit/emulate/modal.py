@@ -573,12 +573,21 @@ class ModalHandler:
         s = self.state
         if chr(int(t.letter[row])) == "T":
             number = int(round(t.number[row] / 10))
+            self._check_tool(number, int(t.line[row]))
             if self.machine.config.tool_change_on == "T":
                 s.tool = number
             s.selected_tool = number
         else:
-            s.selected_tool = int(params.get("T", s.selected_tool))  # ``T1 M6``: the T selects too
+            if "T" in params:  # ``T1 M6``: the T selects too
+                self._check_tool(int(params["T"]), int(t.line[row]))
+            s.selected_tool = int(params.get("T", s.selected_tool))
             s.tool = s.selected_tool
+
+    def _check_tool(self, number: int, line: int) -> None:
+        """With a tool table, selecting a tool it lacks is LinuxCNC's error (T0, no tool, is fine)."""
+        if number and self.machine.config.tool_table and number not in self.machine.tools:
+            self.machine.diagnostics.report(line, 1, f"Requested tool {number} not found in the tool table",
+                                            kind="machine")
 
     def _set_kinematic_position(self, text: str) -> None:
         """Klipper's SET_KINEMATIC_POSITION X=.. Y=.. Z=..: the toolhead is declared there."""

@@ -44,7 +44,18 @@ class Tool:
 
 
 class ToolTable(dict):
-    """Tools by number, with lengths in mm."""
+    """Tools by number, with lengths in mm.
+
+    ``skipped`` lists the lines without a T word, ``(line number, text)``:
+    LinuxCNC skips them with a warning (an old-format table's lines, for one).
+    """
+
+    source = "<tool table>"
+    skipped: list[tuple[int, str]]
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.skipped = []
 
     @classmethod
     def parse(cls, text: str, *, units: str = "mm", source: str = "<tool table>") -> "ToolTable":
@@ -53,13 +64,15 @@ class ToolTable(dict):
             raise ConfigError(f"tool table units must be 'mm' or 'inch', not {units!r}")
         scale = 25.4 if units == "inch" else 1.0
         table = cls()
+        table.source = source
         for number, raw in enumerate(text.splitlines(), 1):
             body, _, comment = raw.partition(";")
             if not body.strip():
                 continue
             words = {k.upper(): float(v) for k, v in _WORD.findall(body)}
             if "T" not in words:
-                raise ConfigError(f"{source}:{number}: a tool table line needs a T word: {raw.strip()!r}")
+                table.skipped.append((number, raw.strip()))
+                continue
             offset = np.array([words.get(a, 0.0) * (scale if a in "XYZ" else 1.0) for a in _AXES])
             tool = Tool(int(words["T"]), int(words.get("P", 0)), offset, words.get("D", 0.0) * scale,
                         comment.strip(), int(words.get("Q", 0)))
