@@ -367,3 +367,15 @@ def test_return_with_another_label_leaves_the_sub_like_rs274():
     op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
     assert op.motions()["x"].tolist() == [4712.0, 246.0]
     assert not op.diagnostics.items
+
+
+def test_abort_comment_stops_with_its_message_where_it_runs() -> None:
+    """LinuxCNC's ``(abort, ...)``: an error on the line that runs it, its parameters filled in (%f)."""
+    import gcodekit
+
+    text = ("#42 = 0\no100 while [#42 lt 5]\no200 if [#42 eq 3]\n(abort, at #42 of #<_n>)\no200 endif\n"
+            "#42 = [#42 + 1]\no100 endwhile\nM2\n")
+    op = gcodekit.gcode_to_operation(text, machine="linuxcnc", plan=False)
+    assert [(d.line, d.message) for d in op.diagnostics.errors] == [(4, "program aborted: at 3.000000 of #<_n>")]
+    quiet = gcodekit.gcode_to_operation("(not an abort, just a comment)\nG0 X1\nM2\n", machine="linuxcnc", plan=False)
+    assert not quiet.diagnostics.errors

@@ -49,6 +49,10 @@ O_WORD_MESSAGE = "O-word control flow is not supported yet (issue #4)"
 # An O-word is the first word of its line, after block delete and N
 # (LinuxCNC ``read_items``); a '(' or ';' ends the match, so commented
 # O-words are not seen.
+#: LinuxCNC's ``(abort, message)`` comment: the program stops with an error showing the message
+_ABORT = re.compile(r"\(\s*abort\s*,([^)]*)\)", re.IGNORECASE)
+#: Parameters a comment message shows (``#42``, ``#<name>``), as LinuxCNC fills them in
+_SHOWN_PARAMETER = re.compile(r"#(\d+|<[^>]*>)")
 _O_WORD = re.compile(r"[ \t]*(?:/[ \t]*)?(?:[nN][0-9. \t]*)?([oO])")
 #: ``O1234`` alone (a comment may follow) names a Fanuc-style program: no flow.
 _PROGRAM_NUMBER = re.compile(r"[ \t]*[oO][0-9]+[ \t]*(\(.*\))?[ \t]*$")
@@ -303,6 +307,10 @@ class ParameterStage:
         :meth:`process` and empty the line.
         """
         text = line.text
+        abort = _ABORT.search(text) if "(" in text else None
+        if abort is not None:
+            diagnostics.report(line.line, abort.start() + 1, f"program aborted: {self._message(abort.group(1))}",
+                               text, kind="machine", file=line.file)
         if not needs_parameters(text):
             return line
         try:
@@ -313,6 +321,18 @@ class ParameterStage:
             diagnostics.report(line.line, where.column, where.message, text, kind=kind, file=line.file)
             return dataclasses.replace(line, text="")
         return line if new == text else dataclasses.replace(line, text=new)
+
+    def _message(self, text: str) -> str:
+        """A comment message with its parameters' values (6 decimals, as LinuxCNC prints them)."""
+        def value(match: re.Match) -> str:
+            key = match.group(1)
+            key = int(key) if key.isdigit() else key[1:-1]
+            try:
+                return f"{self.store.get(key):f}"
+            except GcodeError:
+                return match.group(0)  # unknown here (an INI value, say): left as written
+
+        return _SHOWN_PARAMETER.sub(value, text).strip()
 
     def _substitute(self, text: str) -> str:
         plan = self._plans.get(text)
