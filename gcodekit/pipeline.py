@@ -19,13 +19,13 @@ import os
 import re
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Iterator
+from typing import TYPE_CHECKING, Callable, Iterator, Sequence
 
 import numpy as np
 
 from .emulate.machine import Machine
 from .emulate.operation import OPERATION_CLASSES, Operation
-from .emulate.presets import MachineConfig, default_machine_for, load_machine
+from .emulate.presets import MachineConfig, default_machine_for, load_machine, with_options
 from .emulate.state_parameters import is_state_parameter, machine_parameter
 from .errors import ConfigError, Diagnostics, GcodeError, check_choice
 from .memory import release_freed_memory
@@ -103,7 +103,7 @@ def resolve(program: Program, machine: str | MachineConfig | None, flavor: str |
     if config is None:
         config = load_machine(default_machine_for(fl.name))
     if machine_options:
-        config = dataclasses.replace(config, **machine_options)
+        config = with_options(config, **machine_options)
     return fl, config, how
 
 
@@ -203,7 +203,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
 
     reading_error = None
     try:
-        for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate)):
+        for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate),
+                                     search_path=config.subroutine_path):
             emulate(blocks, lines)
     except GcodeError as exc:  # strict mode: raised below unless a line run before it failed
         reading_error = exc
@@ -247,7 +248,8 @@ def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineCon
 
 
 def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None,
-            machine: tuple[Machine, Callable[[Blocks, int], None]] | None = None) -> Iterator[tuple[Blocks, int]]:
+            machine: tuple[Machine, Callable[[Blocks, int], None]] | None = None,
+            search_path: Sequence[str] = ()) -> Iterator[tuple[Blocks, int]]:
     """Blocks of the program chunk by chunk, preprocessed when it needs it.
 
     With ``machine`` (the machine and a function that parses and emulates
@@ -265,7 +267,7 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         # (until a probe goes by, the watch only collects the lines)
         feedback = _MachineFeedback(flavor, diagnostics, *machine) if machine is not None else None
         store = ParameterStore(system=feedback.system) if feedback is not None else None
-        stages = [ControlFlowStage(flavor, store)] if flavor.parameters and (
+        stages = [ControlFlowStage(flavor, store, search_path=search_path)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text)) else []
         if not stages:
             feedback = None  # no parameters for the machine to give

@@ -379,3 +379,21 @@ def test_abort_comment_stops_with_its_message_where_it_runs() -> None:
     assert [(d.line, d.message) for d in op.diagnostics.errors] == [(4, "program aborted: at 3.000000 of #<_n>")]
     quiet = gcodekit.gcode_to_operation("(not an abort, just a comment)\nG0 X1\nM2\n", machine="linuxcnc", plan=False)
     assert not quiet.diagnostics.errors
+
+
+def test_subroutine_path_and_comments_between_call_arguments(tmp_path) -> None:
+    """A subroutine file found on the machine's ``subroutine_path`` (a string splits at ':', as
+    LinuxCNC's SUBROUTINE_PATH), called with a comment between its arguments, which rs274 skips."""
+    import gcodekit
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    (subs / "go.ngc").write_text("o<go> sub\nG1 X#1 Y#2 F100\no<go> endsub\nM2\n")
+    main = tmp_path / "main.ngc"
+    main.write_text("o<go> call [3] (the Y next) [4]\nM2\n")
+    op = gcodekit.gcode_to_operation(main, machine="linuxcnc", plan=False, subroutine_path=f"/nowhere:{subs}")
+    assert not op.diagnostics.errors
+    last = op.motions().iloc[-1]
+    assert (last.x, last.y) == (3.0, 4.0)
+    missing = gcodekit.gcode_to_operation(main, machine="linuxcnc", plan=False)
+    assert [d.line for d in missing.diagnostics.errors] == [1]  # not found without the path

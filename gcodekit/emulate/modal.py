@@ -509,6 +509,9 @@ class ModalHandler:
             if not 1 <= index <= 9:
                 self.machine.diagnostics.report(line, 1, f"G10 L{mode} P must be 0 to 9", kind="machine")
                 return
+            if params.get("R", 0.0):
+                self.machine.diagnostics.warn(line, 1, f"G10 L{mode} R (the coordinate system's XY rotation) is "
+                                              "not emulated: moves in that system are not rotated")
             for ax in given:
                 value = params[AXES[ax]] * scale[ax]
                 if mode == 2:

@@ -106,6 +106,10 @@ class MachineConfig:
         for none (every tool then has zero offsets).
     tool_table_units : {"mm", "inch"}
         Units of the tool table's lengths (rs274 standalone reads inches).
+    subroutine_path : tuple of str
+        Directories searched, after the program's own, for the subroutine
+        files a program calls by name (``o<name> call``), like LinuxCNC's
+        ``[RS274NGC] SUBROUTINE_PATH``; a string is split at ``:``.
     dwell_s_seconds : bool
         ``G4 S`` is a dwell in seconds (Marlin, RepRapFirmware); Klipper
         ignores S.
@@ -154,6 +158,7 @@ class MachineConfig:
     unretract_speed: float = 10.0
     tool_table: str = ""
     tool_table_units: str = "mm"
+    subroutine_path: tuple[str, ...] = ()
     dwell_s_seconds: bool = True
     planner: str = ""
     planner_settings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
@@ -191,6 +196,11 @@ def load_machine(name_or_path: str | os.PathLike[str], **overrides) -> MachineCo
     return config
 
 
+def with_options(config: MachineConfig, **options) -> MachineConfig:
+    """``config`` with ``options`` replaced, checked and normalised as a preset file's values are."""
+    return _build({**_as_dict(config), **options}, Path(f"<machine {config.name}>"))
+
+
 @functools.lru_cache(maxsize=None)
 def _load(path: Path) -> MachineConfig:
     try:
@@ -224,7 +234,10 @@ def _build(data: dict, path: Path) -> MachineConfig:
             raise ConfigError(f"{path}: [work_offsets] {code} must be one of G54..G59.3 with up to 6 values"
                               + did_you_mean(code, _WORK_OFFSET_CODES))
         offsets[code] = tuple(float(v) for v in vector)
-    data = {**data, "work_offsets": MappingProxyType(offsets),
+    path_list = data.get("subroutine_path", ())
+    if isinstance(path_list, str):
+        path_list = [p for p in path_list.split(":") if p]
+    data = {**data, "work_offsets": MappingProxyType(offsets), "subroutine_path": tuple(map(str, path_list)),
             "planner_settings": MappingProxyType(dict(data.get("planner_settings", data.pop("planner_table", {}))))}
     if "name" not in data:
         data["name"] = path.stem

@@ -606,7 +606,12 @@ class _Run:
             return line
         o_at = match.end() - 1
         ranges = self.stage.parameters.code_ranges(text)
-        end = ranges[0][1] if ranges else len(text)
+        if len(ranges) > 1:  # comments between the words (call arguments, say) are blanked, as rs274 skips them
+            code = [" "] * len(text)
+            for start, stop in ranges:
+                code[start:stop] = text[start:stop]
+            text = "".join(code)
+        end = ranges[-1][1] if ranges else len(text)
         while end > o_at and text[end - 1] in " \t\r" + self.separators:
             end -= 1
         try:
