@@ -118,3 +118,14 @@ def test_cycle_arcs_are_measured_along_the_arc() -> None:
         assert w["distance"][i] == pytest.approx(math.pi)
         assert w["time"][i] == pytest.approx(math.pi / 120 * 60)  # seconds at 120 mm/min
     assert (w["x"][arcs[1]], w["z"][arcs[1]], w["cx"][arcs[1]], w["cz"][arcs[1]]) == (6.0, -4.0, 4.0, -4.0)
+
+
+def test_a_roughing_cycle_that_makes_no_progress_is_an_error_not_a_hang() -> None:
+    """LinuxCNC's tests/interp/g71-endless-loop profile (a step back up the face): rs274 2.9 emits the
+    same zero-length feed forever; gcodekit reports the cycle and goes on."""
+    text = ("G21 G18 G8 G91.1\nO200 SUB\nG01 X10 Z0\nG01 X10 Z-14\nG01 X3\nG01 X7 Z-22\nO200 ENDSUB\n"
+            "F225\nG71.2 Q200 X15.0 Z0 D0.04 I0.5 R1\nG0 X20\nM2\n")
+    op = gcodekit.gcode_to_operation(text, machine="linuxcnc", plan=False)
+    assert [d.line for d in op.diagnostics.errors] == [9]
+    assert "stop making progress" in op.diagnostics.errors[0].message
+    assert op.motions().iloc[-1].x == 20.0  # the program went on after the cycle

@@ -503,9 +503,15 @@ class _Profile:
                     break
                 k += 1
             cycle = 3
+        seen: set[tuple] = set()
         while k < len(segs):
             while x - TOLERANCE > here.imag:
                 x -= self.delta
+            state = (k, round(x, 9), round(here.real, 9), round(here.imag, 9))
+            if state in seen:  # no pass makes progress: rs274 2.9 cuts the same spot forever
+                raise LatheCycleError("G7x error: the roughing passes stop making progress "
+                                      "(LinuxCNC 2.9 loops forever on this profile)")
+            seen.add(state)
             stop, here = segs[k].dive(here, x, out, k == 0)
             if stop:
                 if cycle == 1:
