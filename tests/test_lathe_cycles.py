@@ -129,3 +129,15 @@ def test_a_roughing_cycle_that_makes_no_progress_is_an_error_not_a_hang() -> Non
     assert [d.line for d in op.diagnostics.errors] == [9]
     assert "stop making progress" in op.diagnostics.errors[0].message
     assert op.motions().iloc[-1].x == 20.0  # the program went on after the cycle
+
+
+def test_profile_block_before_any_motion_word_is_a_line() -> None:
+    """rs274 (run_rs274.sh, after G0, G1, G2 and G80 alike; LinuxCNC's tests/interp/g71-endless-loop2):
+    ``Z-333`` opening the profile is a line from the cycle point, so the pass runs down X168 first."""
+    text = ("G18 G21\nF100\nO2 SUB\nZ-333\nG1 X170\nZ-415\nO2 ENDSUB\nG2 X168 Z0 R100\n"
+            "G71 Q2 X168 Z0\nG0 X300 Z10\nM30\n")
+    op = gcodekit.gcode_to_operation(text, machine="linuxcnc", plan=False)
+    cycle = op.motions().query("line == 9")
+    assert list(zip(cycle.motion, cycle.x, cycle.z)) == [
+        ("rapid", 168.0, 0.0), ("rapid", 168.0, 0.0), ("feed", 168.0, -333.0), ("feed", 170.0, -333.0),
+        ("feed", 170.0, -415.0)]

@@ -733,7 +733,9 @@ def run_lathe_cycle(block: CycleBlock) -> LatheCycle:
 
 def _read_profile(block: CycleBlock, start: complex) -> list[dict]:
     """Profile blocks: motion, end point and centre (mm), corner finish."""
-    k, motion, here = block.scale, None, start
+    # a block before the profile's first motion word is a line, whatever mode was in force before
+    # the cycle (rs274 2.9, checked after G0, G1, G2 and G80)
+    k, motion, here = block.scale, 1, start
     halve = 2.0 if block.diameter else 1.0
     out = []
     for text in block.profile.split(";"):
