@@ -366,8 +366,8 @@ def test_g16_refuses_arcs():
 
 
 def test_tapping_and_boring_cycles_by_hand():
-    # G84 feeds out to the clear height; G88 stays at the bottom (manual retract)
-    text = "G21 G90 G0 X0 Y0 Z10\nG98 G84 X5 Y0 Z-4 R2 F100\nG80\nG0 Z10\nG88 X8 Z-3 R1 P2\nG80\n"
+    # G84 feeds out to the clear height; G88 stays at the bottom (manual retract); both need the spindle on
+    text = "G21 G90 G0 X0 Y0 Z10 M3 S500\nG98 G84 X5 Y0 Z-4 R2 F100\nG80\nG0 Z10\nG88 X8 Z-3 R1 P2\nG80\n"
     m = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False).motions()
     assert m[["motion", "x", "z"]].values.tolist() == [
         ["rapid", 0, 10], ["rapid", 5, 10], ["rapid", 5, 2], ["feed", 5, -4], ["feed", 5, 10],
@@ -442,3 +442,24 @@ def test_probe_results_from_a_subroutine_file(tmp_path):
     main.write_text("G21 F50\no<myprobe> call [-3]\nG0 X[#5063 + 10]\nM2\n")
     op = gcodekit.gcode_to_operation(main, "linuxcnc", plan=False)
     np.testing.assert_allclose(op.motions()[["x", "z"]].to_numpy(float), [(0, -3), (7, -2.746)], atol=1e-12)
+
+
+def test_tapping_and_boring_cycles_need_the_spindle_turning():
+    """rs274 (run_rs274.sh): G74, G84, G86 and G88 with the spindle stopped are errors; G81 is not."""
+    for cycle, code in [("G74", "G74"), ("G84", "G84"), ("G86", "g86"), ("G88", "g88")]:
+        text = f"G21 G17 F100\nG0 X0 Y0 Z5\n{cycle} X1 Y1 Z-1 R1 P1\nG80\nM2\n"
+        op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+        assert [(d.line, d.message) for d in op.diagnostics.errors] == [(3, f"Spindle not turning in {code}")]
+    drilled = gcodekit.gcode_to_operation("G21 G17 F100\nG0 X0 Y0 Z5\nG81 X1 Y1 Z-1 R1\nG80\nM2\n", "linuxcnc")
+    assert not drilled.diagnostics.errors
+
+
+def test_arc_radius_tolerance_is_rs274s():
+    """interp_arc.cc: 2*sqrt(2)*0.01 mm and 0.1 % of the larger radius (both exceeded), or 100 times
+    that tolerance; the end radius 1000.5 against 999.5 passes, 0.03 on a radius of 10 does not."""
+    def errors(c: float, d: float) -> list:
+        text = f"G21 G17 F100\nG0 X0 Y0\nG2 X{2 * c + d} I{c}\nM2\n"
+        return [d.line for d in gcodekit.gcode_to_operation(text, "linuxcnc", plan=False).diagnostics.errors]
+
+    assert errors(999.5, 1.0) == [] and errors(999.5, 1.2) == [3]
+    assert errors(10, 0.02) == [] and errors(10, 0.03) == [3]

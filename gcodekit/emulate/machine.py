@@ -428,10 +428,12 @@ class Machine:
         centers[idx, g] = center[:, 1]
 
     def _check_radii(self, t, rows, r0, r1, units) -> None:
-        # LinuxCNC rejects centre-format arcs whose end radius differs from the
-        # start radius by more than 0.0005 in / 0.01 mm and 0.1 % (interp_arc.cc).
-        tolerance = 0.0005 * 25.4 if units != 1.0 else 0.01
-        bad = (np.abs(r1 - r0) > tolerance) & (np.abs(r1 - r0) > 0.001 * r0)
+        # LinuxCNC 2.9 rejects centre-format arcs whose end radius differs from the start
+        # radius by more than its spiral tolerance (2*sqrt(2)*0.01 mm, or 0.001 in in G20)
+        # and 0.1 % of the larger radius, or by 100 times that tolerance (interp_arc.cc)
+        tolerance = 2 * np.sqrt(2) * (0.001 * 25.4 if units != 1.0 else 0.01)
+        error = np.abs(r1 - r0)
+        bad = (error > 100 * tolerance) | ((error > tolerance) & (error > 0.001 * np.maximum(r0, r1)))
         for i in np.flatnonzero(bad)[:20]:
             self.diagnostics.report(int(t.line[rows[i]]), 1,
                                     f"radius to end of arc differs from radius to start by {abs(r1[i] - r0[i]):.4g} mm",

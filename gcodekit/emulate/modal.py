@@ -80,6 +80,11 @@ class Waypoint:
     values: dict[str, float] = field(default_factory=dict)
 
 
+#: Canned cycles rs274 refuses with the spindle stopped (with its spelling of each code)
+_SPINDLE_CYCLES = {"cycle_tap_left": "G74", "cycle_tap": "G84", "cycle_bore_stop": "g86", "cycle_back_bore": "g87",
+                   "cycle_bore_manual": "g88"}
+
+
 class ModalHandler:
     """Applies one state-changing command to a :class:`Machine`'s state."""
 
@@ -269,6 +274,10 @@ class ModalHandler:
                               incremental=s.incremental, dwell_unit=unit)
         except ValueError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
+            return MOTION_NONE, []
+        code = _SPINDLE_CYCLES.get(name or self._cycle_name)
+        if code and s.spindle == 0 and self.machine.rs274_blocks:
+            self.machine.diagnostics.report(line, 1, f"Spindle not turning in {code}", kind="machine")
             return MOTION_NONE, []
         if not steps:
             return MOTION_NONE, []
