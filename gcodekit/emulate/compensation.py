@@ -241,9 +241,10 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
         arc = motion in (MOTION_CW, MOTION_CCW)
         this_path = ("arc", center, new_r1, ccw, grow < 0) if arc else ("line", new_start, in_dir)
         # turning back on itself within the tolerance, rs274 keeps the tool on its side of
-        # both moves (atop an "h" or an "m") when an arc has the tool outside, or before it
+        # both moves (atop an "h" or an "m") when the arc, this one or the one before a
+        # line, has the tool outside it
         reversal = (abs(beta - math.pi) < CONCAVE_CORNER and grow > 0) if arc else \
-            (beta > math.pi - CONCAVE_CORNER and last_path[0] == "arc" and last_path[4])
+            (beta > math.pi - CONCAVE_CORNER and last_path[0] == "arc" and not last_path[4])
         inside = beta < -CONCAVE_CORNER or beta > math.pi + CONCAVE_CORNER or reversal
         gap = np.hypot(*(new_start - start))
         # within CONCAVE_CORNER of straight on, rs274 neither rolls round nor trims: the
