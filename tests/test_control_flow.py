@@ -397,3 +397,12 @@ def test_subroutine_path_and_comments_between_call_arguments(tmp_path) -> None:
     assert (last.x, last.y) == (3.0, 4.0)
     missing = gcodekit.gcode_to_operation(main, machine="linuxcnc", plan=False)
     assert [d.line for d in missing.diagnostics.errors] == [1]  # not found without the path
+
+
+def test_a_named_program_line_is_its_name() -> None:
+    """``O<name>`` alone names the program as ``O1234`` does (LinuxCNC's tests/interp 13-named-program)."""
+    import gcodekit
+
+    op = gcodekit.gcode_to_operation("%\nO<MyProgram> (a name)\nG0 X1\nM30\n%\n", machine="linuxcnc", plan=False)
+    assert not op.diagnostics.items
+    assert op.motions().iloc[-1].x == 1.0

@@ -640,8 +640,8 @@ class _Run:
             raise _error("an O-word needs a number or <name>, as in o100 or o<name>", code.column(pos))
         keyword = _KEYWORD.match(s, pos)
         if keyword is None:
-            if pos == len(s) and label is not None and not label.startswith("<"):
-                return OWord(line, column, "", label)  # Fanuc program number
+            if pos == len(s) and label is not None:
+                return OWord(line, column, "", label)  # a program's number or name (O1234, O<name>)
             rest = re.match(r"[a-z]*", s[pos:]).group() or s[pos:pos + 1]
             hint = did_you_mean(rest, KEYWORDS)
             raise _error(f"unknown O-word keyword {rest!r}{hint}", code.column(pos))

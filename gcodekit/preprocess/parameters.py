@@ -55,7 +55,7 @@ _ABORT = re.compile(r"\(\s*abort\s*,([^)]*)\)", re.IGNORECASE)
 _SHOWN_PARAMETER = re.compile(r"#(\d+|<[^>]*>)")
 _O_WORD = re.compile(r"[ \t]*(?:/[ \t]*)?(?:[nN][0-9. \t]*)?([oO])")
 #: ``O1234`` alone (a comment may follow) names a Fanuc-style program: no flow.
-_PROGRAM_NUMBER = re.compile(r"[ \t]*[oO][0-9]+[ \t]*(\(.*\))?[ \t]*$")
+_PROGRAM_NUMBER = re.compile(r"[ \t]*[oO](?:[0-9]+|<[^>]*>)[ \t]*(\(.*\))?[ \t]*$")
 _SPACE = " \t\r\n\v\f"
 
 # (start, end, replacement) in the line's text, in order; and (key, value).
