@@ -396,7 +396,9 @@ def test_subroutine_path_and_comments_between_call_arguments(tmp_path) -> None:
     last = op.motions().iloc[-1]
     assert (last.x, last.y) == (3.0, 4.0)
     missing = gcodekit.gcode_to_operation(main, machine="linuxcnc", plan=False)
-    assert [d.line for d in missing.diagnostics.errors] == [1]  # not found without the path
+    # not found without the path: rs274 reports it where its search ends, the file's last line
+    assert [d.line for d in missing.diagnostics.errors] == [2]
+    assert "o<go> (called on line 1)" in missing.diagnostics.errors[0].message
 
 
 def test_a_named_program_line_is_its_name() -> None:

@@ -439,8 +439,14 @@ class _Run:
         known = [f"o{k}" for k in table]
         hint = did_you_mean(f"o{label}", known)
         where = ", ".join(str(d) for d in self.directories) or "no search path"
-        message = f"call of unknown {what} o{label}: not in the program nor as {label.strip('<>')}.ngc in {where}{hint}"
         line, column = (st.line, st.column) if isinstance(st, OWord) else (st, 1)
+        called = f"o{label}"
+        if table is self.subs and self.code.items:
+            # rs274 looks for the sub down to the end of the file and reports the error there
+            last = self.code.items[-1]
+            line, column = (last.line if isinstance(last, OWord) else last), 1
+            called += f" (called on line {st.line.line if isinstance(st, OWord) else st.line})"
+        message = f"call of unknown {what} {called}: not in the program nor as {label.strip('<>')}.ngc in {where}{hint}"
         self._report(line, column, message)
         return None
 
