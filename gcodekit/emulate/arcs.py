@@ -78,6 +78,13 @@ def arc_length(radius: np.ndarray, angle: np.ndarray, helix: np.ndarray) -> np.n
     return np.hypot(radius * angle, helix)
 
 
+def single_turn_lengths(start: np.ndarray, end: np.ndarray, center: np.ndarray, clockwise: np.ndarray,
+                        helix: np.ndarray) -> np.ndarray:
+    """Lengths of arcs of less than a turn (in-plane points, shape (n, 2)) rising by ``helix``."""
+    angle = sweep(start, end, center, clockwise, np.ones(len(start)))
+    return arc_length(np.hypot(*(start - center).T), angle, helix)
+
+
 def interior_points(start: np.ndarray, end: np.ndarray, center: np.ndarray, plane: np.ndarray,
                     clockwise: np.ndarray, length: np.ndarray, max_angle: float = np.radians(5.0)):
     """Points inside arcs, for drawing them as poly-lines.

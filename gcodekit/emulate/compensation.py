@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, MOTION_RAPID, NAME_ID
-from .arcs import PLANES, arc_length, sweep
+from .arcs import PLANES, single_turn_lengths
 
 if TYPE_CHECKING:
     from .operation import Operation
@@ -420,6 +420,5 @@ def _recompute_lengths(w: dict) -> None:
         (f, g, h), _ = PLANES[int(code)]
         idx = np.flatnonzero(arcs & (plane == code))
         p0, p1, c = previous[idx][:, [f, g]], points[idx][:, [f, g]], centers[idx][:, [f, g]]
-        angle = sweep(p0, p1, c, motion[idx] == MOTION_CW, np.ones(idx.size))
-        distance[idx] = arc_length(np.hypot(*(p0 - c).T), angle, points[idx, h] - previous[idx, h])
+        distance[idx] = single_turn_lengths(p0, p1, c, motion[idx] == MOTION_CW, points[idx, h] - previous[idx, h])
     w["distance"] = distance

@@ -107,7 +107,7 @@ class Machine:
         self.tools = ToolTable.read(config.tool_table, units=config.tool_table_units) if config.tool_table else ToolTable()
         for number, text in self.tools.skipped[:20]:
             self.diagnostics.report(number, 1, "tool table line without a T word skipped (as LinuxCNC does)", text,
-                               severity="warning", file=self.tools.source)
+                                    severity="warning", file=self.tools.source)
         self.modal = ModalHandler(self)
         self._straight_ids = np.array([NAME_ID["rapid"], NAME_ID["linear"]], np.uint8)
         self._table_z, self._table_w = np.nan, 0.0  # last Z and table-axis words (see _part_frame)

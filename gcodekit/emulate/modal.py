@@ -18,7 +18,7 @@ import numpy as np
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_RAPID,
                            MOTION_THREAD, NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
 from ..parse.commands import Kind
-from .arcs import PLANES, arc_length, center_from_radius, reach_tolerance, sweep
+from .arcs import PLANES, center_from_radius, reach_tolerance, single_turn_lengths
 from .cycles import CYCLES, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
@@ -656,9 +656,8 @@ class ModalHandler:
         centre = np.asarray(centre, float)
         if motion not in (MOTION_CW, MOTION_CCW) or np.isnan(centre[[f, g]]).any():
             return float(np.linalg.norm((point - before)[:3]))
-        p0, p1, c = before[[f, g]][None], point[[f, g]][None], centre[[f, g]][None]
-        angle = sweep(p0, p1, c, np.array([motion == MOTION_CW]), np.ones(1))
-        return float(arc_length(np.hypot(*(p0 - c).T), angle, np.array([point[h] - before[h]]))[0])
+        return float(single_turn_lengths(before[[f, g]][None], point[[f, g]][None], centre[[f, g]][None],
+                                         np.array([motion == MOTION_CW]), np.array([point[h] - before[h]]))[0])
 
     def _write(self, out: dict, row: int, before: np.ndarray, motion: int, de: float = 0.0,
                feed: float | None = None) -> None:

@@ -42,7 +42,7 @@ from ..emulate.exporters import format_number
 from ..emulate.lathe import profile_of, program_comment
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
-from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, NAME_ID, NAMES, PROFILE_TAG
+from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, NAME_ID, NAMES, PROFILE_TAG
 from .cycle_words import cycle_offset, diameter_words, lathe_defaults, length_words, level_words, rewrite_profile
 
 STAGES = tuple(range(7))
@@ -296,7 +296,7 @@ class Transpiler:
         if name in CYCLE_NAMES or int(self.op.table.motion[row]) == MOTION_CYCLE:
             if name not in CYCLE_NAMES:  # axis words alone, repeating the cycle in force
                 name = NAMES[int(self.op.table.name[self._last_cycle_row[row]])]
-            feeds = np.asarray(w["motion"])[points] == 2
+            feeds = np.asarray(w["motion"])[points] == MOTION_LINEAR
             return cycle_offset(name, words, scale, positions, feeds, int(w["plane"][points[-1]]))
         return np.array([positions[-1, i] - words[a] * scale if a in words else 0.0 for i, a in enumerate("XYZ")])
 
