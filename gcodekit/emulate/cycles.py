@@ -29,6 +29,7 @@ waypoints of the block.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,9 +68,13 @@ class CycleState:
     initial: np.ndarray | None = None
 
 
-def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarray, program: np.ndarray,
-              offset: np.ndarray, scale: np.ndarray, plane: int, incremental: bool, dwell_unit: float) -> list[Step]:
+def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray,
+              to_machine: Callable[[np.ndarray], np.ndarray], scale: np.ndarray, plane: int, incremental: bool,
+              dwell_unit: float) -> list[Step]:
     """Moves of one canned-cycle block (``params`` as written, in program units).
+
+    The cycle works in program coordinates (mm) from ``program``, the
+    current point; ``to_machine`` places each of its points on the machine.
 
     Raises
     ------
@@ -106,17 +111,16 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
         raise ValueError("G73/G83 need a positive Q")
     clear = r if cycle.retract_to_r or old < r else old
     below_r = old < r
-    to_machine = offset[axis]
     steps: list[Step] = []
-    here = position.copy()
+    here = program.copy()
 
     def go(coord: float, motion: int, dwell: float = 0.0) -> None:
-        here[axis] = coord + to_machine
-        steps.append(Step(here.copy(), motion, dwell))
+        here[axis] = coord
+        steps.append(Step(to_machine(here), motion, dwell))
 
     def slide(aside: bool) -> None:  # G87: rapid to the side step off the hole centre, or back
-        here[[a, b]] = target[[a, b]] + offset[[a, b]] + (cycle.shift if aside else 0.0)
-        steps.append(Step(here.copy(), MOTION_RAPID))
+        here[[a, b]] = target[[a, b]] + (cycle.shift if aside else 0.0)
+        steps.append(Step(to_machine(here), MOTION_RAPID))
 
     if below_r:  # preliminary move up to the R plane
         go(r, MOTION_RAPID)
@@ -127,11 +131,11 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, position: np.ndarra
         for ax, word in ((a, first), (b, second)):
             if word in params:
                 target[ax] = target[ax] + params[word] * scale[ax] if incremental else params[word] * scale[ax]
-        here[[a, b]] = target[[a, b]] + offset[[a, b]]  # rs274 emits it even when already there
+        here[[a, b]] = target[[a, b]]  # rs274 emits it even when already there
         if not cycle.retract_to_r:  # G98: over the hole at the clear height (up from R after a G99 block)
-            here[axis] = clear + to_machine
-        steps.append(Step(here.copy(), MOTION_RAPID))
-        if here[axis] != r + to_machine:
+            here[axis] = clear
+        steps.append(Step(to_machine(here), MOTION_RAPID))
+        if here[axis] != r:
             go(r, MOTION_RAPID)
         if cycle.name == "cycle_back_bore":
             _back_bore(bottom + cycle.k if incremental else cycle.k, bottom, clear, go, slide)  # G91: K from Z

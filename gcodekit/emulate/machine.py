@@ -221,7 +221,7 @@ class Machine:
         """
         s = self.state
         target = s.position.copy()
-        self.probe_result = (target - s.offset + s.program_shift) / s.scale()
+        self.probe_result = s.program_position() / s.scale()
         self.probes += 1
         back = start[:3] - target[:3]
         length = float(np.linalg.norm(back))
@@ -291,21 +291,21 @@ class Machine:
         if not self.config.radius_arcs and "R" in t.params:
             self._reject_radius_arcs(t, rows, moving)
         motion = np.where(moving, t.motion[rows], 0).astype(np.uint8)
-        offset = s.offset
         scale = s.scale()
         program = s.program_position()
-        position = np.empty((n, 6))
+        targets = np.empty((n, 6))  # program coordinates, mm
         for ax, letter in enumerate(AXES):
             col = t.params.get(letter)
             if col is None:
-                position[:, ax] = program[ax] + offset[ax]
+                targets[:, ax] = program[ax]
                 continue
             values = _dense(col, rows) * scale[ax]
             values[~moving] = np.nan
             if s.incremental:
-                position[:, ax] = program[ax] + np.cumsum(np.nan_to_num(values)) + offset[ax]
+                targets[:, ax] = program[ax] + np.cumsum(np.nan_to_num(values))
             else:
-                position[:, ax] = _forward_fill(values, program[ax]) + offset[ax]
+                targets[:, ax] = _forward_fill(values, program[ax])
+        position = s.to_machine(targets)
         if s.program_shift.any():  # until the first move the machine stays where it is
             waiting = np.cumsum(moving) == 0
             position[waiting] = s.position
@@ -331,7 +331,8 @@ class Machine:
         centers = np.full((n, 3), np.nan)
         is_arc = (motion == MOTION_CW) | (motion == MOTION_CCW)
         if is_arc.any():
-            self._arcs(t, start, np.flatnonzero(is_arc), start_pos, position, centers, distance, offset, scale)
+            program_start = np.vstack([program[None, :], targets[:-1]])
+            self._arcs(t, start, np.flatnonzero(is_arc), program_start, targets, centers, distance)
         rotary = np.sqrt(np.einsum("ij,ij->i", delta[:, 3:], delta[:, 3:]))
         speed = self._spindle_speeds(t, rows, kind)
         if s.feed_mode == "per_rev":  # G95: F is mm per spindle revolution
@@ -391,8 +392,12 @@ class Machine:
         words[~np.isin(kind, _MILL)] = np.nan
         return _forward_fill(words, self.state.speed)
 
-    def _arcs(self, t, start, idx, start_pos, end_pos, centers, distance, offset, scale) -> None:
-        """Centers and lengths of the arc rows ``idx`` (relative to ``start``)."""
+    def _arcs(self, t, start, idx, start_pos, end_pos, centers, distance) -> None:
+        """Centres (machine coordinates) and lengths of the arc rows ``idx`` (relative to ``start``).
+
+        ``start_pos`` and ``end_pos`` are program coordinates, the frame I/J/K
+        and R are given in; the centre then turns with the work system.
+        """
         s = self.state
         (f, g, h), (l1, l2) = arcs.PLANES[s.plane]
         rows = idx + start
@@ -407,10 +412,9 @@ class Machine:
         for i in np.flatnonzero(no_center)[:20]:
             self.diagnostics.report(int(t.line[rows[i]]), 1, f"arc needs {l1}/{l2} offsets or R in this plane (G{s.plane})",
                                     kind="machine")
+        center = np.column_stack([np.nan_to_num(o1), np.nan_to_num(o2)])
         if s.arc_incremental:
-            center = p0 + np.column_stack([np.nan_to_num(o1), np.nan_to_num(o2)])
-        else:
-            center = np.column_stack([np.nan_to_num(o1) + offset[f], np.nan_to_num(o2) + offset[g]])
+            center += p0
         if by_radius.any():
             c, reach = arcs.center_from_radius(p0[by_radius], p1[by_radius], r_word[by_radius], clockwise[by_radius])
             center[by_radius] = c
@@ -424,9 +428,14 @@ class Machine:
         self._check_radii(t, rows, radius, radius_end, s.units)
         rise = end_pos[idx, h] - start_pos[idx, h]
         distance[idx] = arcs.arc_length(radius, angle, rise)
-        centers[idx, f] = center[:, 0]
-        centers[idx, g] = center[:, 1]
-
+        centre = end_pos[idx, :].copy()  # the helix axis keeps the end point's coordinate, then is blanked
+        centre[:, f], centre[:, g] = center[:, 0], center[:, 1]
+        if s.rotation and s.plane != 17:
+            self._once("tilted arc", int(t.line[rows[0]]), f"arc in G{s.plane} under an XY rotation of the work "
+                       "system: its plane turns out of the machine's planes, which the centre columns cannot show")
+        centre = s.to_machine(centre)
+        centers[idx, f] = centre[:, f]
+        centers[idx, g] = centre[:, g]
     def _check_radii(self, t, rows, r0, r1, units) -> None:
         # LinuxCNC 2.9 rejects centre-format arcs whose end radius differs from the start
         # radius by more than its spiral tolerance (2*sqrt(2)*0.01 mm, or 0.001 in in G20)

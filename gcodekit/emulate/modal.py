@@ -23,7 +23,7 @@ from .cycles import CYCLES, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
 from .splines import SPLINE_NAMES, SplineBlocks
-from .state import AXES, MachineState
+from .state import AXES, MachineState, rotate_xy
 from .tooltable import Tool
 
 if TYPE_CHECKING:
@@ -174,7 +174,9 @@ class ModalHandler:
             if attr == "incremental" and self.machine.config.distance_mode_sets_extrusion:
                 s.e_relative = value
         elif name.startswith("work_offset_"):
+            believed = s.to_machine(s.program_position())  # where rs274 thinks the machine is
             s.work_offset = int(name.rsplit("_", 1)[1])
+            s.keep_program_position(s.to_program(believed))
         elif name == "set_position":
             self._set_position(params, line, t)
         elif name == "clear_position_offset":
@@ -259,8 +261,9 @@ class ModalHandler:
         given = [ax for ax, letter in enumerate(AXES) if letter in params]
         if not given and "E" not in params and self.machine.config.home_mode == "stored":
             self.machine.diagnostics.report(line, 1, "G92 needs at least one axis word", kind="machine")
-        for ax in given:
-            s.g92[ax] = s.position[ax] - s.work_offsets[s.work_offset][ax] - params[AXES[ax]] * scale[ax]
+        program = s.program_position()
+        for ax in given:  # the offset sits before the rotation: the given point in the unturned frame
+            s.g92[ax] = program[ax] + s.g92[ax] - params[AXES[ax]] * scale[ax]
         if "E" in params:
             s.e_program = params["E"] * s.units
 
@@ -269,8 +272,8 @@ class ModalHandler:
         s = self.state
         unit = 0.001 if self.machine.config.dwell_p_unit == "ms" else 1.0
         try:
-            steps = run_cycle(name if name in CYCLES else "", params, s.cycle, position=s.position,
-                              program=s.program_position(), offset=s.offset, scale=s.scale(), plane=s.plane,
+            steps = run_cycle(name if name in CYCLES else "", params, s.cycle,
+                              program=s.program_position(), to_machine=s.to_machine, scale=s.scale(), plane=s.plane,
                               incremental=s.incremental, dwell_unit=unit)
         except ValueError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
@@ -303,16 +306,15 @@ class ModalHandler:
                                 j=params["J"] * k / halve, k=params["K"] * k / halve, q=params.get("Q", 0.0),
                                 h=int(params.get("H", 0)), r=params.get("R", 1.0), e=params.get("E", 0.0) * k,
                                 taper=int(params.get("L", 0)))
-        offset = s.offset
         steps = []
         for kind, x, z, pitch in moves + [("rapid", end[0], end[2], None)]:
             point = program.copy()
             point[0], point[2] = x, z
-            values = {**dict(zip(AXES.lower(), point + offset)), "motion": MOTION_RAPID}
+            values = {**dict(zip(AXES.lower(), s.to_machine(point))), "motion": MOTION_RAPID}
             if pitch is not None:  # synchronized with the spindle: pitch per revolution
                 values.update(motion=MOTION_LINEAR, feed=pitch * s.speed)
             steps.append(Waypoint(values))
-        s.position = end + offset
+        s.position = s.to_machine(end)
         return MOTION_RAPID, steps[:-1]
 
     def _after_lathe_cycle(self, params: dict, line: int) -> int:
@@ -323,17 +325,19 @@ class ModalHandler:
         if arc and not any(k in params for k in "IJKR"):
             self.machine.diagnostics.report(line, 1, "R i j k words all missing for arc", kind="machine")
             return MOTION_NONE
-        before = self.state.position.copy()
+        before = self.state.program_position()
         self._move_to(self._program_target(params), params)
         if arc:
             self._last_centre = self._arc_centre(before, params, motion == MOTION_CW, line)
         return motion or MOTION_LINEAR
 
     def _arc_centre(self, before: np.ndarray, params: dict, clockwise: bool, line: int) -> tuple:
-        """Centre (machine X Y Z, the plane's normal NaN) of an arc from ``before`` to the position, by I/J/K or R."""
+        """Centre (machine X Y Z, the plane's normal NaN) of an arc from program point ``before`` to the
+        position, by I/J/K or R."""
         s = self.state
-        (f, g, _), (l1, l2) = PLANES[s.plane]
-        p0, p1 = before[[f, g]], s.position[[f, g]]
+        (f, g, h), (l1, l2) = PLANES[s.plane]
+        after = s.program_position()
+        p0, p1 = before[[f, g]], after[[f, g]]
         if "R" in params:
             centre, reach = center_from_radius(p0[None], p1[None], np.array([params["R"] * s.units]),
                                                np.array([clockwise]))
@@ -343,9 +347,11 @@ class ModalHandler:
             in_plane = centre[0]
         else:
             words = np.array([params.get(l1, 0.0), params.get(l2, 0.0)]) * s.units
-            in_plane = p0 + words if s.arc_incremental else words + s.offset[[f, g]]
-        centre = np.full(3, np.nan)
+            in_plane = p0 + words if s.arc_incremental else words
+        centre = after.copy()
         centre[[f, g]] = in_plane
+        centre = s.to_machine(centre)[:3]
+        centre[h] = np.nan
         return tuple(centre)
 
     def _lathe_cycle(self, name: str, params: dict, comment: str | None, line: int) -> tuple[int, list[Waypoint]]:
@@ -359,22 +365,24 @@ class ModalHandler:
         except LatheCycleError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
             return MOTION_NONE, []
-        offset = s.offset
         if s.compensating:
-            self.machine.comp_profile_ends.append(
-                (line, np.array([profile_end.imag, program[1], profile_end.real]) + offset[:3]))
+            end = program.copy()
+            end[[0, 2]] = profile_end.imag, profile_end.real
+            self.machine.comp_profile_ends.append((line, s.to_machine(end)[:3]))
         here = program.copy()
         steps = []
         kinds = {"rapid": MOTION_RAPID, "feed": MOTION_LINEAR}
         for move in [Move("rapid", point)] + moves:
             end = program.copy()
             end[[0, 2]] = move.end.imag, move.end.real
-            values = dict(zip(AXES.lower(), end + offset))
+            values = dict(zip(AXES.lower(), s.to_machine(end)))
             if move.kind == "arc":
                 if abs(end[0] - here[0]) < 1e-4 and abs(end[2] - here[2]) < 1e-4:
                     continue  # rs274 skips an arc that ends where it starts
-                values.update(motion=MOTION_CCW if move.ccw else MOTION_CW, cx=move.centre.imag + offset[0],
-                              cy=np.nan, cz=move.centre.real + offset[2])
+                centre = end.copy()
+                centre[[0, 2]] = move.centre.imag, move.centre.real
+                centre = s.to_machine(centre)
+                values.update(motion=MOTION_CCW if move.ccw else MOTION_CW, cx=centre[0], cy=np.nan, cz=centre[2])
             else:
                 values["motion"] = kinds[move.kind]
             steps.append(Waypoint(values))
@@ -422,7 +430,7 @@ class ModalHandler:
         rate = self._synchronized_rate(params, line, "G33.1")
         if rate is None:
             return None
-        bottom = self._program_target(params, "XYZ") + self.state.offset
+        bottom = self.state.to_machine(self._program_target(params, "XYZ"))
         return Waypoint({**dict(zip(AXES.lower(), bottom)), "motion": MOTION_LINEAR, "feed": rate})
 
     def _spline(self, t: CommandTable, row: int, name: str, params: dict) -> tuple[int, list[Waypoint]]:
@@ -451,8 +459,9 @@ class ModalHandler:
             return MOTION_NONE, []
         if chords is None:
             return MOTION_NONE, []
-        points = np.repeat(s.position[None, :], len(chords) - 1, axis=0)
-        points[:, :2] = chords[1:] + s.offset[:2]
+        points = np.repeat(s.program_position()[None, :], len(chords) - 1, axis=0)
+        points[:, :2] = chords[1:]
+        points = s.to_machine(points)
         extra = [Waypoint({**dict(zip(AXES.lower(), p)), "motion": MOTION_LINEAR}) for p in points[:-1]]
         s.position = points[-1].copy()
         return MOTION_LINEAR, extra
@@ -504,7 +513,7 @@ class ModalHandler:
         for ax, letter in enumerate(AXES):
             if letter in params and letter not in "XY":
                 program[ax] = program[ax] + params[letter] * scale[ax] if s.incremental else params[letter] * scale[ax]
-        s.position = program + s.offset
+        s.position = s.to_machine(program)
         s.program_shift[:] = 0.0
 
     def _coordinate_data(self, params: dict, line: int) -> None:
@@ -518,15 +527,14 @@ class ModalHandler:
             if not 1 <= index <= 9:
                 self.machine.diagnostics.report(line, 1, f"G10 L{mode} P must be 0 to 9", kind="machine")
                 return
-            if params.get("R", 0.0):
-                self.machine.diagnostics.warn(line, 1, f"G10 L{mode} R (the coordinate system's XY rotation) is "
-                                              "not emulated: moves in that system are not rotated")
-            for ax in given:
-                value = params[AXES[ax]] * scale[ax]
-                if mode == 2:
-                    s.work_offsets[index, ax] = value
-                else:  # L20: the current point gets coordinate `value` in system P
-                    s.work_offsets[index, ax] = s.position[ax] - s.g92[ax] - s.tool_offset[ax] - value
+            if mode == 20 and "R" in params:
+                self.machine.diagnostics.report(line, 1, "R not allowed in G10 L20", kind="machine")
+                return
+            values = {ax: params[AXES[ax]] * scale[ax] for ax in given}
+            if mode == 2:
+                self._set_work_system(index, values, params.get("R"))
+            else:
+                self._touch_off_work_system(index, values)
         elif mode in (1, 10, 11):
             number = int(params.get("P", 0))
             tool = self.machine.tools.setdefault(number, Tool(number))
@@ -545,6 +553,42 @@ class ModalHandler:
         else:
             self.machine.diagnostics.report(line, 1, "G10 needs L1, L2, L10, L11 or L20", kind="machine")
 
+    def _set_work_system(self, index: int, values: dict[int, float], rotation: float | None) -> None:
+        """G10 L2: work system ``index`` gets offsets ``values`` (mm by axis) and maybe a new XY rotation.
+
+        In the system in force rs274 turns its idea of the current point
+        with the new rotation, leaving out the G92 offset (so the machine
+        moves on the next move when a G92 offset and a rotation change
+        meet; LinuxCNC's tests/interp coord-rotation-xy keeps that too).
+        """
+        s = self.state
+        old_offset, old_rotation = s.work_offsets[index].copy(), float(s.rotations[index])
+        program = s.program_position()
+        for ax, value in values.items():
+            s.work_offsets[index, ax] = value
+        if rotation is not None:
+            s.rotations[index] = rotation
+        if index == s.work_offset:
+            moved = old_offset - s.work_offsets[index]
+            s.keep_program_position(rotate_xy(rotate_xy(program, old_rotation) + moved, -s.rotation))
+
+    def _touch_off_work_system(self, index: int, values: dict[int, float]) -> None:
+        """G10 L20: work system ``index`` moves so the current point has coordinates ``values`` in it.
+
+        Axes without a word keep their coordinate in that system, so under a
+        rotation an X word alone moves the system's origin in X and Y.
+        """
+        s = self.state
+        believed = s.to_machine(s.program_position())  # where rs274 thinks the machine is
+        rotation = float(s.rotations[index])
+        frame = believed - s.work_offsets[index] - s.tool_offset
+        program = rotate_xy(frame, -rotation) - s.g92
+        for ax, value in values.items():
+            program[ax] = value
+        s.work_offsets[index] = frame + s.work_offsets[index] - rotate_xy(program + s.g92, rotation)
+        if index == s.work_offset:
+            s.keep_program_position(program)
+
     def _home(self, params: dict, secondary: bool) -> list[Waypoint]:
         s = self.state
         stored = s.home_secondary if secondary else s.home
@@ -555,12 +599,12 @@ class ModalHandler:
             return []
         extra = []
         if given:
-            via = s.position.copy()
             program = s.program_position()
             scale = s.scale()
             for ax in given:
                 value = params[AXES[ax]] * scale[ax]
-                via[ax] = (program[ax] + value if s.incremental else value) + s.offset[ax]
+                program[ax] = program[ax] + value if s.incremental else value
+            via = s.to_machine(program)
             extra.append(Waypoint({k: v for k, v in zip(AXES.lower(), via)} | {"motion": MOTION_RAPID}))
             s.position[:] = np.where(np.isin(np.arange(6), given), stored, via)
         else:

@@ -1,8 +1,11 @@
 """Emulate stage: the modal state of a machine between two commands.
 
-Positions are machine coordinates in millimetres (degrees for A, B, C), so
-the program position is ``position - work_offset - g92_offset``.  Offsets
-and stored positions are millimetres too, whatever units the program uses.
+Positions are machine coordinates in millimetres (degrees for A, B, C).  As
+in LinuxCNC, a program point reaches the machine as
+``rotate(program + g92, rotation) + work_offset + tool_offset``: the G92/G52
+offset turns with the work system's XY rotation (G10 L2 R), the work and
+tool offsets do not.  Offsets and stored positions are millimetres too,
+whatever units the program uses.
 """
 
 from __future__ import annotations
@@ -21,6 +24,18 @@ MM_PER_INCH = 25.4
 
 def _zeros() -> np.ndarray:
     return np.zeros(N_AXES)
+
+
+def rotate_xy(points: np.ndarray, degrees: float) -> np.ndarray:
+    """``points`` (one X Y Z A B C point, or rows of them) turned about Z by ``degrees``, counter-clockwise."""
+    points = np.array(points, float)
+    if degrees:
+        angle = np.radians(degrees)
+        cos, sin = np.cos(angle), np.sin(angle)
+        x, y = points[..., 0].copy(), points[..., 1].copy()
+        points[..., 0] = x * cos - y * sin
+        points[..., 1] = x * sin + y * cos
+    return points
 
 
 @dataclass
@@ -42,11 +57,13 @@ class MachineState:
     flow: float = 1.0  # M221, as a ratio
     work_offset: int = 1  # 1..9 for G54..G59.3
     work_offsets: np.ndarray = field(default_factory=lambda: np.zeros((10, N_AXES)))
+    rotations: np.ndarray = field(default_factory=lambda: np.zeros(10))  # each work system's XY rotation, degrees
     g92: np.ndarray = field(default_factory=_zeros)
     tool_offset: np.ndarray = field(default_factory=_zeros)  # G43 tool length offset
     # rs274 keeps the program position when the tool offset changes in an M6
-    # block: the machine reaches the new offset on the next move.  Until then
-    # the program position differs from position - offset by this much.
+    # block, and turns it with a work system's new rotation: the machine reaches
+    # the new frame on the next move.  Until then the program position differs
+    # from to_program(position) by this much (see keep_program_position).
     program_shift: np.ndarray = field(default_factory=_zeros)
     g92_saved: np.ndarray | None = None
     home: np.ndarray = field(default_factory=_zeros)  # G28 stored position
@@ -63,12 +80,31 @@ class MachineState:
     ended: bool = False  # M2/M30 reached: later blocks are not run
 
     @property
-    def offset(self) -> np.ndarray:
-        """Total offset from program to machine coordinates."""
-        return self.work_offsets[self.work_offset] + self.g92 + self.tool_offset
+    def rotation(self) -> float:
+        """XY rotation of the work system in force, degrees counter-clockwise."""
+        return float(self.rotations[self.work_offset])
+
+    def to_machine(self, program: np.ndarray) -> np.ndarray:
+        """Program coordinates (one point or rows of points, mm) in machine coordinates."""
+        turned = rotate_xy(np.asarray(program, float) + self.g92, self.rotation)
+        return turned + self.work_offsets[self.work_offset] + self.tool_offset
+
+    def to_program(self, machine: np.ndarray) -> np.ndarray:
+        """Machine coordinates (one point or rows of points) in program coordinates, mm."""
+        untool = np.asarray(machine, float) - self.work_offsets[self.work_offset] - self.tool_offset
+        return rotate_xy(untool, -self.rotation) - self.g92
 
     def program_position(self) -> np.ndarray:
-        return self.position - self.offset + self.program_shift
+        return self.to_program(self.position) + self.program_shift
+
+    def keep_program_position(self, program: np.ndarray) -> None:
+        """After an offset change: the program position is ``program`` until the next move.
+
+        The machine stays where it is; a move then goes to its program
+        target in the new frame (rs274 keeps its own idea of the position).
+        """
+        shift = np.asarray(program, float) - self.to_program(self.position)
+        self.program_shift = np.where(np.abs(shift) < 1e-9, 0.0, shift)
 
     def change_tool_offset(self, offset: np.ndarray, keep_program_position: bool = False) -> None:
         """New tool length offset, taking effect without motion.
@@ -80,7 +116,7 @@ class MachineState:
         before = self.program_position()
         self.tool_offset = np.asarray(offset, float).copy()
         if keep_program_position:
-            self.program_shift = before - (self.position - self.offset)
+            self.keep_program_position(before)
 
     def scale(self) -> np.ndarray:
         """Program units to mm per axis (rotary axes stay in degrees)."""
