@@ -309,6 +309,52 @@ def test_tool_length_offset_in_the_tool_change_block_keeps_program_position(tmp_
     np.testing.assert_allclose(op.motions()[["x", "z"]].to_numpy(), [[1, 0.5]], atol=1e-12)
 
 
+def test_xy_rotation_turns_the_program_frame_about_the_work_origin():
+    """G10 L2 R: machine = rotate(program + G92) + G5x (values worked out by hand)."""
+    text = "\n".join([
+        "G21 G90 G0 X10 Y0",
+        "G10 L2 P1 X10 Y0 R90",  # G54's origin at (10, 0), its X axis along machine +Y
+        "G1 X1 F100",            # program (1, 0) -> machine (10, 1)
+        "G91 Y2",                # an increment along program Y runs along machine -X: (8, 1)
+        "G90",
+        "G2 X-1 Y2 I-1 J0",      # centre program (0, 2) -> machine (8, 0), end (-1, 2) -> (8, -1)
+        "G92 X0 Y0",             # the G92 offset sits before the rotation: program (-1, 2) is now (0, 0)
+        "G1 X1",                 # program (1, 0) + G92 (-1, 2) = (0, 2) -> machine (8, 0)
+        "G92.1",
+        "G55 G1 X3 Y4",          # G55 is not turned
+        "G54 G1 X0 Y0",
+        "G10 L2 P1 R0",          # back to square: rs274 turns its idea of the point with it
+        "G1 X5",
+        "M2",
+    ]) + "\n"
+    op, df = run(text)
+    assert not op.diagnostics.items
+    m = op.motions()
+    np.testing.assert_allclose(m[["x", "y"]].to_numpy(), [
+        [10, 0], [10, 1], [8, 1], [8, -1], [8, 0], [3, 4], [10, 0], [15, 0]], atol=1e-12)
+    np.testing.assert_allclose(m[["cx", "cy"]].to_numpy()[3], [8, 0], atol=1e-12)
+    assert df.loc[df["line"] == 3, "rotation"].tolist() == [90.0]
+    assert df.loc[df["line"] == 13, "rotation"].tolist() == [0.0]
+
+
+def test_g10_l20_under_a_rotation_moves_the_origin_along_both_axes():
+    # in G54 turned 90 degrees at (0, 0), the point machine (0, 5) is program (5, 0); X0 alone keeps
+    # program Y 0, so the origin moves to machine (0, 5) and the next X1 goes to machine (0, 6)
+    op, _ = run("G21 G0 X0 Y5\nG10 L2 P1 R90\nG10 L20 P1 X0\nG1 X1 F100\nM2\n")
+    np.testing.assert_allclose(op.motions()[["x", "y"]].to_numpy()[-1], [0, 6], atol=1e-12)
+    op, _ = run("G21\nG10 L20 P1 X0 R30\nM2\n")
+    assert [(d.line, d.message) for d in op.diagnostics.items] == [(2, "R not allowed in G10 L20")]
+
+
+def test_g92_leaves_the_tool_length_offset_out_of_its_offset(tmp_path):
+    # program Z 10 with a 12.7 mm tool is machine Z 22.7; G92 Z0 makes the offset 10, so Z-1 is machine 21.7
+    table = tmp_path / "tools.tbl"
+    table.write_text("T1 P1 Z12.7\n")
+    op, _ = run("G21 T1 M6\nG43 H1\nG0 Z10\nG92 Z0\nG1 Z-1 F100\nM2\n", tool_table=table,
+                tool_table_units="mm")
+    np.testing.assert_allclose(op.motions()["z"].to_numpy(), [22.7, 21.7], atol=1e-12)
+
+
 def test_canned_cycles_follow_linuxcnc():
     text = "G21 G90 G17 G0 X0 Y0 Z10\nG98 G81 X10 Y5 Z-3 R2 F100\nX20\nG99 G83 X30 Z-5 R1 Q2\nG80\nG0 Z10\n"
     m = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False).motions()
@@ -463,3 +509,21 @@ def test_arc_radius_tolerance_is_rs274s():
 
     assert errors(999.5, 1.0) == [] and errors(999.5, 1.2) == [3]
     assert errors(10, 0.02) == [] and errors(10, 0.03) == [3]
+
+
+@pytest.mark.parametrize("block, group", [("G90 G91", "distance mode"), ("G20 G21", "units"), ("G17 G18", "plane"),
+                                          ("G54 G55", "coordinate system"), ("G41 G40", "cutter compensation"),
+                                          ("G98 G99 G81 X0 Z-1 R1 F10", "canned cycle return"),
+                                          ("G4 P1 G92 X0", "non-modal"), ("M3 M5", "spindle"),
+                                          ("M7 M8", "coolant"), ("M0 M2", "stopping")])
+def test_two_codes_of_one_modal_group_are_refused_as_rs274_does(block, group):
+    # rs274 2.9: "Two g codes used from same modal group" (and m codes, M7 M8 included)
+    op, _ = run(f"G21\n{block}\nM2\n")
+    assert any(d.line == 2 and f"same modal group ({group})" in d.message for d in op.diagnostics.items)
+
+
+def test_codes_of_different_groups_share_a_block():
+    op, _ = run("G21 G90 G17 G54 G94 M3 S100 M8\nG53 G0 X1\nG10 L2 P1 X1 G54\nG0 X0\nM2\n")
+    assert not op.diagnostics.items
+    # Fanuc takes the last code of a group without an alarm
+    assert not gcodekit.gcode_to_operation("G90 G91 G0 X1\nM30\n", "fanuc", plan=False).diagnostics.items

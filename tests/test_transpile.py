@@ -139,3 +139,19 @@ def test_cycles_move_alike_at_every_stage():
         again = gcodekit.gcode_to_operation(t.stage(k), "linuxcnc", plan=False)
         assert not again.diagnostics.items, (k, again.diagnostics.items[:2])
         np.testing.assert_allclose(path_of(again), reference, atol=1e-3, equal_nan=True, err_msg=f"stage {k}")
+
+
+def test_rotated_work_systems_move_alike_at_every_stage():
+    """Under G10 L2 R, moves (cycles and G90.1 arcs too) are written from waypoints from stage 2."""
+    from test_linuxcnc_golden import tool_table
+
+    case = GOLDEN / "own__xy_rotation.ngc"
+    t = Transpiler(operation(case))
+    reference = path_of(t.op)
+    for k in STAGES:
+        again = gcodekit.gcode_to_operation(t.stage(k), "linuxcnc", plan=False, tool_table=tool_table(case.name),
+                                            tool_table_units="inch")
+        assert not again.diagnostics.items, (k, again.diagnostics.items[:2])
+        np.testing.assert_allclose(path_of(again), reference, atol=1e-3, equal_nan=True, err_msg=f"stage {k}")
+    code = [line for line in t.stage(2).splitlines() if not line.startswith("(")]
+    assert not [line for line in code if "G10" in line or "G81" in line]  # the rotation and its cycles resolved

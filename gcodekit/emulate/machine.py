@@ -46,6 +46,7 @@ SMALL_COLUMNS = {
     "laser": (np.uint8, "1 while the laser/weld heat source is on (DED: M61 on, M62 off)"),
     "work_offset": (np.uint8, "1..9 for G54..G59.3"),
     "flow": (np.float32, "extrusion multiplier in force (M221), ratio: de is the programmed E times it"),
+    "rotation": (np.float64, "XY rotation of the work system in force (G10 L2 R), degrees counter-clockwise"),
 }
 _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTRUDE, Kind.MOVE_MILL,
                            Kind.ARC_MILL, Kind.EXTRUDE}), np.uint8)
@@ -276,6 +277,7 @@ class Machine:
         out["laser"][rows] = s.laser
         out["work_offset"][rows] = s.work_offset
         out["flow"][rows] = s.flow
+        out["rotation"][rows] = s.rotation
 
     # -- runs of plain commands ---------------------------------------------------
 

@@ -63,6 +63,30 @@ _RANK = {
 _RANK_OTHER_M = 13
 _RANK_OTHER_G = 22
 
+#: RS274NGC's modal groups (LinuxCNC 2.9 "Modal Groups"; group 1, motion, is
+#: checked on its own), by normalized command.  Group 0 holds the non-modal codes.
+_MODAL_GROUPS = {
+    **dict.fromkeys(("dwell", "coordinate_data", "home", "home_secondary", "store_home", "store_home_secondary",
+                     "machine_coordinates", "set_position", "clear_position_offset", "suspend_position_offset",
+                     "restore_position_offset", "local_offset"), "non-modal"),
+    **dict.fromkeys(("plane_xy", "plane_zx", "plane_yz"), "plane"),
+    **dict.fromkeys(("distance_absolute", "distance_incremental"), "distance mode"),
+    **dict.fromkeys(("arc_distance_absolute", "arc_distance_incremental"), "arc distance mode"),
+    **dict.fromkeys(("feed_inverse_time", "feed_per_minute", "feed_per_rev"), "feed mode"),
+    **dict.fromkeys(("units_inch", "units_mm"), "units"),
+    **dict.fromkeys(("cutter_comp_off", "cutter_comp_left", "cutter_comp_right", "cutter_comp_left_dynamic",
+                     "cutter_comp_right_dynamic"), "cutter compensation"),
+    **dict.fromkeys(("tool_length_offset", "tool_length_offset_dynamic", "tool_length_offset_add",
+                     "cancel_tool_length"), "tool length offset"),
+    **dict.fromkeys(("retract_initial", "retract_r"), "canned cycle return"),
+    **{f"work_offset_{k}": "coordinate system" for k in range(1, 10)},
+    **dict.fromkeys(("exact_stop", "path_blending"), "path control"),
+    **dict.fromkeys(("diameter_mode", "radius_mode"), "lathe diameter mode"),
+    **dict.fromkeys(("program_stop", "optional_stop", "program_end"), "stopping"),
+    **dict.fromkeys(("spindle_cw", "spindle_ccw", "spindle_off"), "spindle"),
+    **dict.fromkeys(("coolant_mist", "coolant_flood", "coolant_off"), "coolant"),
+}
+
 
 @dataclass
 class Part:
@@ -147,6 +171,8 @@ def _split_modal(words, flavor):
     if len(motion) > 1 and not (len(motion) == 2 and "cancel_cycle" in (motion[0][0], motion[1][0])):
         # rs274 takes "G80 G0": the G80 only says what the G0 does anyway
         problems.append("more than one motion code in the block; the last is used")
+    if flavor.modal_group_conflicts:
+        problems += _group_conflicts(named)
     g53 = [n for n in named if n[0] == "machine_coordinates"]
     parts: list[tuple[int, Part]] = []
     for name, letter, value in named:
@@ -193,6 +219,22 @@ def _split_modal(words, flavor):
         else:
             ordered.append(Part("", params={letter: rest.pop(letter)}))
     return ordered, problems
+
+
+def _group_conflicts(named: list[tuple[str, str, float]]) -> list[str]:
+    """Messages for codes that share a modal group with an earlier code of the block."""
+    first: dict[str, str] = {}
+    problems = []
+    for name, letter, value in named:
+        group = _MODAL_GROUPS.get(name)
+        code = code_label(letter, round(value * 10))
+        if group is None:
+            continue
+        if group in first:
+            problems.append(f"two codes from the same modal group ({group}): {first[group]} and {code}")
+        else:
+            first[group] = code
+    return problems
 
 
 def _insert_at(ordered: list[Part], flavor: Flavor, rank: int) -> int:

@@ -125,6 +125,9 @@ class Flavor:
         A line holding only ``%`` starts or ends the program.
     block_split : {"modal", "single", "sequential"}
         See :data:`BLOCK_SPLITS`.
+    modal_group_conflicts : bool
+        Two codes of one modal group in a block (``G90 G91``, ``M3 M5``)
+        are an error, as in RS274NGC; otherwise the last one wins.
     string_codes : frozenset of str
         Codes whose remaining text is one string argument (``M117 Hello``).
     other_codes : frozenset of str
@@ -200,6 +203,7 @@ class Flavor:
     parameters: bool = False
     percent_delimiter: bool = False
     block_split: str = "single"
+    modal_group_conflicts: bool = False
     string_codes: frozenset[str] = frozenset()
     other_codes: frozenset[str] = frozenset()
     extended_commands: bool = False

@@ -15,6 +15,11 @@ with canned cycles):
    waypoints from stage 4 on, so G40/G41/G42 already go at stage 4);
 6. canned cycles expanded into the moves they make.
 
+A work system turned by G10 L2 R cannot be written as offsets added to
+words (an X word alone moves along both machine axes), so from stage 2 the
+moves made under a rotation, canned cycles included, are written from the
+emulated waypoints.
+
 The last stage uses only G0/G1/G2/G3 (arcs outside XY carry their G18/G19),
 G4 and tool, spindle and coolant codes.  Every line starts with the N-number
 of the source line it came from.  Stages 4-6 are written from the emulated
@@ -90,6 +95,10 @@ class Transpiler:
         # once the program has an arc outside XY
         self._plane_words = bool(np.any(np.asarray(w["plane"])[arcs] != 17))
         self._polar_rows = mode_rows(self.op.table, "polar_on", "polar_off")  # G16: X radius, Y angle
+        # moves under a G10 L2 R rotation are written from their waypoints from stage 2
+        self._rotated_rows = np.zeros(len(self.op.table), bool)
+        turned = np.asarray(w["rotation"]) != 0
+        np.logical_or.at(self._rotated_rows, w["command"] if "command" in w else np.arange(turned.size), turned)
         self._incremental_rows = mode_rows(self.op.table, "distance_incremental", "distance_absolute")  # G91
         self._arc_absolute_rows = mode_rows(self.op.table, "arc_distance_absolute", "arc_distance_incremental")
         # the last cycle command at or before each row (axis words alone repeat it)
@@ -153,7 +162,7 @@ class Transpiler:
         motion_row = moving.size and np.any(self.op.waypoints["motion"][moving] > 0)
         polar = "@" in cmd.params or "^" in cmd.params or self._polar_rows[row]
         polar_stage = 2 if self._polar_rows[row] else 3
-        if motion_row and (k >= 4 or (polar and k >= polar_stage)):
+        if motion_row and (k >= 4 or (polar and k >= polar_stage) or (self._rotated_rows[row] and k >= 2)):
             return self._from_waypoints(row, k, moving, comment)
         if (k >= 1 and name in _UNITS) or (k >= 2 and name in _OFFSETS) or (k >= 4 and name in _DISTANCE) \
                 or (k >= 2 and name in _POLAR) or (k >= 4 and name in _COMP) or (k >= 6 and name in _CYCLE_MODES):
@@ -224,10 +233,11 @@ class Transpiler:
         t, w = self.op.table, self.op.waypoints
         n = f"N{int(t.line[row])}"
         cycle = int(t.motion[row]) == MOTION_CYCLE or NAMES[int(t.name[row])] in CYCLE_NAMES
-        if cycle and k < 6:
+        if cycle and k < 6 and not self._rotated_rows[row]:
             return [f"{n} {self._words(row, t.command(row), k)}{comment}"]
         fmt = lambda v: format_number(v, self.precision)  # noqa: E731
         increments = k < 4 and self._incremental(row)
+        absolute_centre = k < 4 and bool(self._arc_absolute_rows[row])  # G90.1 still in force
 
         def value(axis: str, p: int) -> float:
             column = w[axis.lower()]
@@ -249,7 +259,7 @@ class Transpiler:
             if motion == 2 or self._is_point_arc(p):  # a helix of radius 0 is a straight line
                 lines.append(f"{n} G1 {coords}{feed}")
             else:
-                lines.append(f"{n} {self._arc(p, motion)} {coords}{feed}")
+                lines.append(f"{n} {self._arc(p, motion, absolute_centre)} {coords}{feed}")
         if lines:
             lines[-1] += comment
         dwell = t.command(row).params.get("P") if cycle and NAMES[int(t.name[row])] in (
@@ -265,10 +275,11 @@ class Transpiler:
         center = np.array([w["cx"][p], w["cy"][p], w["cz"][p]])
         return bool(np.nansum((center - start) ** 2) < 1e-18)
 
-    def _arc(self, p: int, motion: int) -> str:
+    def _arc(self, p: int, motion: int, absolute_centre: bool) -> str:
+        """G2/G3 and the centre words of the arc ending at waypoint ``p`` (I/J/K absolute under G90.1)."""
         w = self.op.waypoints
         plane = int(w["plane"][p])
-        start = np.array([w[a][p - 1] if p > 0 else 0.0 for a in "xyz"])
+        start = np.zeros(3) if absolute_centre else np.array([w[a][p - 1] if p > 0 else 0.0 for a in "xyz"])
         center = np.array([w["cx"][p], w["cy"][p], w["cz"][p]])
         offsets = np.nan_to_num(center - start) / self.unit
         words = " ".join(f"{letter}{format_number(offsets[i], self.precision)}"
