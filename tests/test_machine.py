@@ -527,3 +527,20 @@ def test_codes_of_different_groups_share_a_block():
     assert not op.diagnostics.items
     # Fanuc takes the last code of a group without an alarm
     assert not gcodekit.gcode_to_operation("G90 G91 G0 X1\nM30\n", "fanuc", plan=False).diagnostics.items
+
+
+@pytest.mark.parametrize("block, letter", [("G1 X1 R5 F10", "R"), ("G64 P1 R0.5", "R"), ("G0 X1 P1", "P"),
+                                           ("G1 X1 Q1 F1", "Q"), ("G1 X1 L2 F1", "L"), ("G0 X1 H1", "H"),
+                                           ("G0 X1 D1", "D"), ("G0 X1 K1", "K"), ("M3 P1 S100", "P"),
+                                           ("G33 Z-1 K0.1 D90", "D")])
+def test_a_word_no_code_of_the_block_uses_is_refused_as_rs274_does(block, letter):
+    # each block run in rs274 2.9: "R word with no g code that uses it", "P word with no G2 G3 G4 ..."
+    op, _ = run(f"G21 G0 X0 Y0 Z0\nS100 M3\n{block}\nM2\n")
+    assert [d.message.split()[0] for d in op.diagnostics.items if d.line == 3] == [letter]
+
+
+def test_words_their_code_or_motion_mode_uses_pass():
+    text = ("G21 S100 M3\nG43 H1\nG41 D1 G1 X1 F10\nG40 G0 X5\nG2 X10 Y0 R3\nX15 R3\nG81 X0 Y0 Z-1 R1\nX2\n"
+            "G82 X1 Y1 Z-1 R1 P2\nG80 G4 P1\nG10 L2 P1 R30\nG64 P0.1 Q0.1\nM2\n")
+    op, _ = run(text)
+    assert not [d for d in op.diagnostics.items if "word with no" in d.message]

@@ -24,7 +24,8 @@ from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
-from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CUBIC, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
+from .word_checks import MODAL_USERS, WORD_USERS, message, stray_letters
+from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CCW, MOTION_CUBIC, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
                     MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable)
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
@@ -349,7 +350,33 @@ class GcodeParser:
             for i in np.flatnonzero(straight & missing)[:100].tolist():
                 absent = ",".join(c for c in self.flavor.required_axes if c not in params or np.isnan(params[c][i]))
                 self.diagnostics.warn(int(t["line"][i]), 1, f"motion without {absent} (this dialect writes every axis)")
+        if self.flavor.rs274ngc_block_checks:
+            self._report_stray_words(t, motion, implicit)
         t["name"], t["motion"], t["kind"] = name, motion, kind
+
+    def _report_stray_words(self, t: dict, motion: np.ndarray, implicit: np.ndarray) -> None:
+        """RS274NGC: a word no code of its block uses (``G1 X1 R5``) is an error (see :mod:`.word_checks`)."""
+        letter, number, params = t["letter"], t["number"], t["params"]
+        keys = letter.astype(np.int64) * 1_000_000 + number.astype(np.int64)
+        modal = {MOTION_CW: "arc", MOTION_CCW: "arc", MOTION_CYCLE: "cycle", MOTION_THREAD: "thread",
+                 MOTION_NURBS: "nurbs", MOTION_CUBIC: "spline", MOTION_QUADRATIC: "spline"}
+        suspect = np.zeros(letter.size, bool)
+        for c in WORD_USERS:
+            if c not in params:
+                continue
+            by_own_code = np.isin(keys, _word_user_keys(c))
+            by_mode = implicit & np.isin(motion, [m for m, mode in modal.items() if c in MODAL_USERS[mode]])
+            suspect |= ~np.isnan(params[c]) & ~by_own_code & ~by_mode
+        reported = 0
+        for block in np.unique(t["block"][suspect]).tolist():
+            rows = np.flatnonzero(t["block"] == block)
+            codes = [code_label(chr(letter[i]), int(number[i])) for i in rows if letter[i] in (_G, _M)]
+            given = {c for c in WORD_USERS if c in params and (~np.isnan(params[c][rows])).any()}
+            moving = [int(motion[i]) for i in rows if implicit[i]]
+            for c in stray_letters(given, codes, modal.get(moving[0]) if moving else None):
+                if reported < 100:
+                    self.diagnostics.report(int(t["line"][rows[0]]), 1, message(c))
+                reported += 1
 
     def _report_unknown(self, t: dict, name: np.ndarray) -> None:
         letter, number = t["letter"], t["number"]
@@ -377,6 +404,17 @@ def _forward_fill_modes(sets: np.ndarray, initial: int) -> np.ndarray:
     np.maximum.accumulate(idx, out=idx)
     out = np.where(idx >= 0, sets[np.maximum(idx, 0)], initial).astype(np.uint8)
     return out
+
+
+_WORD_USER_KEYS: dict[str, np.ndarray] = {}
+
+
+def _word_user_keys(word: str) -> np.ndarray:
+    """Keys (letter * 1e6 + tenths) of the codes that take ``word``."""
+    if word not in _WORD_USER_KEYS:
+        _WORD_USER_KEYS[word] = np.array(sorted(ord(code[0]) * 1_000_000 + round(float(code[1:]) * 10)
+                                                for code in WORD_USERS[word]), np.int64)
+    return _WORD_USER_KEYS[word]
 
 
 def _merge_rows(fast: dict, slow: dict) -> dict:

@@ -171,7 +171,7 @@ def _split_modal(words, flavor):
     if len(motion) > 1 and not (len(motion) == 2 and "cancel_cycle" in (motion[0][0], motion[1][0])):
         # rs274 takes "G80 G0": the G80 only says what the G0 does anyway
         problems.append("more than one motion code in the block; the last is used")
-    if flavor.modal_group_conflicts:
+    if flavor.rs274ngc_block_checks:
         problems += _group_conflicts(named)
     g53 = [n for n in named if n[0] == "machine_coordinates"]
     parts: list[tuple[int, Part]] = []

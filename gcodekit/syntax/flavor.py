@@ -125,9 +125,10 @@ class Flavor:
         A line holding only ``%`` starts or ends the program.
     block_split : {"modal", "single", "sequential"}
         See :data:`BLOCK_SPLITS`.
-    modal_group_conflicts : bool
-        Two codes of one modal group in a block (``G90 G91``, ``M3 M5``)
-        are an error, as in RS274NGC; otherwise the last one wins.
+    rs274ngc_block_checks : bool
+        RS274NGC's block checks: two codes of one modal group (``G90 G91``,
+        ``M3 M5``) or a word no code of the block uses (``G1 X1 R5``) are
+        errors; otherwise the last code wins and a stray word is ignored.
     string_codes : frozenset of str
         Codes whose remaining text is one string argument (``M117 Hello``).
     other_codes : frozenset of str
@@ -203,7 +204,7 @@ class Flavor:
     parameters: bool = False
     percent_delimiter: bool = False
     block_split: str = "single"
-    modal_group_conflicts: bool = False
+    rs274ngc_block_checks: bool = False
     string_codes: frozenset[str] = frozenset()
     other_codes: frozenset[str] = frozenset()
     extended_commands: bool = False
