@@ -26,7 +26,7 @@ import numpy as np
 from .emulate.machine import Machine
 from .emulate.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine, with_options
-from .emulate.state_parameters import is_state_parameter, machine_parameter
+from .emulate.state_parameters import is_state_parameter, is_stored_parameter, machine_parameter, set_machine_parameter
 from .errors import ConfigError, Diagnostics, GcodeError, check_choice
 from .memory import release_freed_memory
 from .parse import CommandTable, GcodeParser
@@ -266,7 +266,7 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         # probes and reads of their results may sit in subroutine files: watch every program
         # (until a probe goes by, the watch only collects the lines)
         feedback = _MachineFeedback(flavor, diagnostics, *machine) if machine is not None else None
-        store = ParameterStore(system=feedback.system) if feedback is not None else None
+        store = ParameterStore(system=feedback.system, system_writes=feedback) if feedback is not None else None
         stages = [ControlFlowStage(flavor, store, search_path=search_path)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text)) else []
         if not stages:
@@ -393,6 +393,15 @@ class _MachineFeedback:
             self._catch_up()
             return machine_parameter(self.machine, key)
         return None
+
+    def writable(self, key: int | str) -> bool:
+        """Whether ``key`` is a stored offset or position the program may write (see ``SystemWrites``)."""
+        return self.state_parameters and is_stored_parameter(key)
+
+    def write(self, key: int | str, value: float) -> None:
+        """Write a stored offset or position into the machine, once the lines before have run."""
+        self._catch_up()
+        set_machine_parameter(self.machine, key, value)
 
     def _catch_up(self) -> None:
         """Emulate the held lines."""

@@ -515,7 +515,8 @@ def test_arc_radius_tolerance_is_rs274s():
                                           ("G54 G55", "coordinate system"), ("G41 G40", "cutter compensation"),
                                           ("G98 G99 G81 X0 Z-1 R1 F10", "canned cycle return"),
                                           ("G4 P1 G92 X0", "non-modal"), ("M3 M5", "spindle"),
-                                          ("M7 M8", "coolant"), ("M0 M2", "stopping")])
+                                          ("M7 M8", "coolant"), ("M0 M2", "stopping"),
+                                          ("G92.1 G92.2", "G92 offset switch"), ("G28.1 G4 P1", "non-modal")])
 def test_two_codes_of_one_modal_group_are_refused_as_rs274_does(block, group):
     # rs274 2.9: "Two g codes used from same modal group" (and m codes, M7 M8 included)
     op, _ = run(f"G21\n{block}\nM2\n")
@@ -523,7 +524,8 @@ def test_two_codes_of_one_modal_group_are_refused_as_rs274_does(block, group):
 
 
 def test_codes_of_different_groups_share_a_block():
-    op, _ = run("G21 G90 G17 G54 G94 M3 S100 M8\nG53 G0 X1\nG10 L2 P1 X1 G54\nG0 X0\nM2\n")
+    # rs274 2.9 lets G92.1-G92.3 share a block with another non-modal code
+    op, _ = run("G21 G90 G17 G54 G94 M3 S100 M8\nG53 G0 X1\nG10 L2 P1 X1 G54\nG0 X0\nG92.1 G52 X0\nM2\n")
     assert not op.diagnostics.items
     # Fanuc takes the last code of a group without an alarm
     assert not gcodekit.gcode_to_operation("G90 G91 G0 X1\nM30\n", "fanuc", plan=False).diagnostics.items

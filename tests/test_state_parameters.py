@@ -55,3 +55,23 @@ def test_other_dialects_keep_ordinary_parameters():
     # Fanuc macro programs use #5001.. for positions; #5420 is just a variable there
     op = gcodekit.gcode_to_operation("G21 G0 X10\n#5420 = 3\nG0 X[#5420]\nM30\n", "fanuc", plan=False)
     assert moves(op) == [10.0, 3.0]
+
+
+def test_stored_offsets_read_and_write_the_machine():
+    # mm machine (the default tool table units): G10 L2 P2 X5 stores 5 in #5241, R30 in #5230
+    op = run("G21\nG10 L2 P2 X5\nG10 L2 P1 R30\nG0 X[#5241] Y[#5230]\nM2\n")
+    assert not op.diagnostics.items
+    assert moves(op, "x") == pytest.approx([5 * np.cos(np.radians(30)) - 30 * np.sin(np.radians(30))])
+    # a written G54 offset waits for G54 to be selected again (rs274 ignores G54 while in G54)
+    op = run("G21\n#5221 = 3\nG0 X0\nG54\nG0 X0\nG55\nG54\nG0 X0\nM2\n")
+    assert not op.diagnostics.items
+    assert moves(op) == [0.0, 0.0, 3.0]
+
+
+def test_stored_g92_offset_and_home_positions():
+    # G92.2 suspends the offset (#5210 0) but keeps it stored (#5211) for G92.3, a written one too
+    op = run("G21\nG0 X10\nG92 X4\nG92.2\nG0 X[#5210] Y[#5211]\n#5211 = 1\nG92.3\nG0 X0\nM2\n")
+    assert [tuple(p) for p in zip(moves(op, "x"), moves(op, "y"))] == [(10, 0), (0, 6), (1, 6)]
+    # G28 goes through the current point (no length) to the position written in #5161..
+    op = run("G21\nG0 X1 Y1\n#5161 = 7\n#5162 = 8\nG28\nM2\n")
+    assert [tuple(p) for p in zip(moves(op, "x"), moves(op, "y"))] == [(1, 1), (1, 1), (7, 8)]

@@ -105,6 +105,7 @@ class Machine:
             self.state.feed = config.initial_feed
         for code, vector in config.work_offsets.items():
             self.state.work_offsets[_WORK_INDEX[code], : len(vector)] = vector
+        self.state.select_work_system(1)
         self.tools = ToolTable.read(config.tool_table, units=config.tool_table_units) if config.tool_table else ToolTable()
         for number, text in self.tools.skipped[:20]:
             self.diagnostics.report(number, 1, "tool table line without a T word skipped (as LinuxCNC does)", text,

@@ -173,20 +173,21 @@ class ModalHandler:
             setattr(s, attr, value)
             if attr == "incremental" and self.machine.config.distance_mode_sets_extrusion:
                 s.e_relative = value
-        elif name.startswith("work_offset_"):
+        elif name.startswith("work_offset_") and int(name.rsplit("_", 1)[1]) != s.work_offset:
             believed = s.to_machine(s.program_position())  # where rs274 thinks the machine is
-            s.work_offset = int(name.rsplit("_", 1)[1])
+            s.select_work_system(int(name.rsplit("_", 1)[1]))  # (selecting the system in force changes nothing)
             s.keep_program_position(s.to_program(believed))
         elif name == "set_position":
             self._set_position(params, line, t)
         elif name == "clear_position_offset":
             s.g92[:] = 0.0
-            s.g92_saved = None
-        elif name == "suspend_position_offset":
-            s.g92_saved, s.g92 = s.g92.copy(), np.zeros_like(s.g92)
+            s.g92_stored[:] = 0.0
+            s.g92_on = False
+        elif name == "suspend_position_offset":  # the stored offset stays for G92.3
+            s.g92[:] = 0.0
+            s.g92_on = False
         elif name == "restore_position_offset":
-            if s.g92_saved is not None:
-                s.g92 = s.g92_saved.copy()
+            s.g92, s.g92_on = s.g92_stored.copy(), True
         elif name in ("home", "home_secondary"):
             motion, extra = MOTION_RAPID, self._home(params, name == "home_secondary")
         elif name == "store_home":
@@ -237,6 +238,7 @@ class ModalHandler:
             for ax, letter in enumerate(AXES):
                 if letter in params:  # LinuxCNC keeps G52 in the G92 offset
                     s.g92[ax] = params[letter] * scale[ax]
+            s.g92_stored, s.g92_on = s.g92.copy(), True
         elif name == "set_kinematic_position":
             self._set_kinematic_position(t.command(row).text)
         elif name in ("firmware_retract", "firmware_unretract"):
@@ -264,6 +266,8 @@ class ModalHandler:
         program = s.program_position()
         for ax in given:  # the offset sits before the rotation: the given point in the unturned frame
             s.g92[ax] = program[ax] + s.g92[ax] - params[AXES[ax]] * scale[ax]
+        if given:
+            s.g92_stored, s.g92_on = s.g92.copy(), True
         if "E" in params:
             s.e_program = params["E"] * s.units
 
@@ -543,7 +547,7 @@ class ModalHandler:
                 if mode == 1:
                     tool.offset[ax] = value
                 else:  # the current point would have coordinate `value` with this tool's offset
-                    system = s.work_offsets[9 if mode == 11 else s.work_offset]
+                    system = s.work_offsets[9] if mode == 11 else s.frame
                     g92 = 0.0 if mode == 11 else s.g92[ax]
                     tool.offset[ax] = s.position[ax] - system[ax] - g92 - value
             if "R" in params:
@@ -562,14 +566,15 @@ class ModalHandler:
         meet; LinuxCNC's tests/interp coord-rotation-xy keeps that too).
         """
         s = self.state
-        old_offset, old_rotation = s.work_offsets[index].copy(), float(s.rotations[index])
+        old_offset, old_rotation = s.frame.copy(), s.frame_rotation
         program = s.program_position()
         for ax, value in values.items():
             s.work_offsets[index, ax] = value
         if rotation is not None:
             s.rotations[index] = rotation
-        if index == s.work_offset:
-            moved = old_offset - s.work_offsets[index]
+        if index == s.work_offset:  # the system's stored values, all of them, come into force
+            s.select_work_system(index)
+            moved = old_offset - s.frame
             s.keep_program_position(rotate_xy(rotate_xy(program, old_rotation) + moved, -s.rotation))
 
     def _touch_off_work_system(self, index: int, values: dict[int, float]) -> None:
@@ -587,6 +592,7 @@ class ModalHandler:
             program[ax] = value
         s.work_offsets[index] = frame + s.work_offsets[index] - rotate_xy(program + s.g92, rotation)
         if index == s.work_offset:
+            s.select_work_system(index)
             s.keep_program_position(program)
 
     def _home(self, params: dict, secondary: bool) -> list[Waypoint]:
@@ -597,19 +603,18 @@ class ModalHandler:
             for ax in given or [0, 1, 2]:
                 s.position[ax] = stored[ax]
             return []
-        extra = []
-        if given:
-            program = s.program_position()
-            scale = s.scale()
-            for ax in given:
-                value = params[AXES[ax]] * scale[ax]
-                program[ax] = program[ax] + value if s.incremental else value
-            via = s.to_machine(program)
-            extra.append(Waypoint({k: v for k, v in zip(AXES.lower(), via)} | {"motion": MOTION_RAPID}))
-            s.position[:] = np.where(np.isin(np.arange(6), given), stored, via)
-        else:
-            s.position = stored.copy()
-        return extra
+        # rs274 goes through the given point; with no axis words through the current
+        # one (a rapid of no length), then every axis goes to the stored position
+        program = s.program_position()
+        scale = s.scale()
+        for ax in given:
+            value = params[AXES[ax]] * scale[ax]
+            program[ax] = program[ax] + value if s.incremental else value
+        via = s.to_machine(program)
+        # the given axes reach the stored position as program coordinates (a rotation mixes X and Y)
+        s.position = s.to_machine(np.where(np.isin(np.arange(6), given), s.to_program(stored), program)) \
+            if given else stored.copy()
+        return [Waypoint({k: v for k, v in zip(AXES.lower(), via)} | {"motion": MOTION_RAPID})]
 
     def _machine_move(self, params: dict, motion: int, line: int) -> int:
         """G53: move to machine coordinates in this block only."""
@@ -671,7 +676,8 @@ class ModalHandler:
     def _end_program(self) -> None:
         """M2/M30: LinuxCNC resets these modes and stops reading the program."""
         s = self.state
-        s.work_offset, s.plane, s.incremental, s.feed_mode = 1, 17, False, "per_minute"
+        s.select_work_system(1)
+        s.plane, s.incremental, s.feed_mode = 17, False, "per_minute"
         s.spindle, s.coolant, s.compensating = 0, 0, False
         s.ended = True
 

@@ -56,16 +56,21 @@ class MachineState:
     e_total: float = 0.0  # filament pushed so far (mm)
     flow: float = 1.0  # M221, as a ratio
     work_offset: int = 1  # 1..9 for G54..G59.3
+    # Each work system's offsets and XY rotation (degrees) as stored (LinuxCNC's
+    # #5221-#5390); the system in force applies its stored values when selected.
     work_offsets: np.ndarray = field(default_factory=lambda: np.zeros((10, N_AXES)))
-    rotations: np.ndarray = field(default_factory=lambda: np.zeros(10))  # each work system's XY rotation, degrees
-    g92: np.ndarray = field(default_factory=_zeros)
+    rotations: np.ndarray = field(default_factory=lambda: np.zeros(10))
+    frame: np.ndarray = field(default_factory=_zeros)  # the work offset in force
+    frame_rotation: float = 0.0  # the XY rotation in force, degrees
+    g92: np.ndarray = field(default_factory=_zeros)  # the G92/G52 offset in force
+    g92_stored: np.ndarray = field(default_factory=_zeros)  # as stored (#5211-#5219): G92.3 brings it back
+    g92_on: bool = False  # #5210: set by G92, G52 and G92.3, cleared by G92.1 and G92.2
     tool_offset: np.ndarray = field(default_factory=_zeros)  # G43 tool length offset
     # rs274 keeps the program position when the tool offset changes in an M6
     # block, and turns it with a work system's new rotation: the machine reaches
     # the new frame on the next move.  Until then the program position differs
     # from to_program(position) by this much (see keep_program_position).
     program_shift: np.ndarray = field(default_factory=_zeros)
-    g92_saved: np.ndarray | None = None
     home: np.ndarray = field(default_factory=_zeros)  # G28 stored position
     home_secondary: np.ndarray = field(default_factory=_zeros)  # G30 stored position
     tool: int = 0
@@ -82,17 +87,23 @@ class MachineState:
     @property
     def rotation(self) -> float:
         """XY rotation of the work system in force, degrees counter-clockwise."""
-        return float(self.rotations[self.work_offset])
+        return self.frame_rotation
+
+    def select_work_system(self, index: int) -> None:
+        """G54..G59.3 (1..9): the system's stored offsets and rotation come into force."""
+        self.work_offset = index
+        self.frame = self.work_offsets[index].copy()
+        self.frame_rotation = float(self.rotations[index])
 
     def to_machine(self, program: np.ndarray) -> np.ndarray:
         """Program coordinates (one point or rows of points, mm) in machine coordinates."""
-        turned = rotate_xy(np.asarray(program, float) + self.g92, self.rotation)
-        return turned + self.work_offsets[self.work_offset] + self.tool_offset
+        turned = rotate_xy(np.asarray(program, float) + self.g92, self.frame_rotation)
+        return turned + self.frame + self.tool_offset
 
     def to_program(self, machine: np.ndarray) -> np.ndarray:
         """Machine coordinates (one point or rows of points) in program coordinates, mm."""
-        untool = np.asarray(machine, float) - self.work_offsets[self.work_offset] - self.tool_offset
-        return rotate_xy(untool, -self.rotation) - self.g92
+        untool = np.asarray(machine, float) - self.frame - self.tool_offset
+        return rotate_xy(untool, -self.frame_rotation) - self.g92
 
     def program_position(self) -> np.ndarray:
         return self.to_program(self.position) + self.program_shift

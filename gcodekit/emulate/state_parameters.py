@@ -8,6 +8,16 @@ coordinate system), ``#5400`` (the tool in the spindle), ``#5401``-``#5409``
 (``#<_imperial>``, ``#<_plane>``, ``#<_feed>``, ``#<_rpm>``, ...).  Their
 values are those before the reading line runs, as rs274 gives them.
 
+The stored positions and offsets are parameters a program may also write:
+``#5161``-``#5166`` (G28's position), ``#5181``-``#5186`` (G30's),
+``#5210`` (G92 offset on), ``#5211``-``#5216`` (the G92 offset G92.3 brings
+back), and per work system ``#5221``-``#5226`` and ``#5230`` (G54's offsets
+and XY rotation), ``#5241``.. (G55) up to ``#5381``.. (G59.3).  As in rs274,
+a written work offset comes into force when its system is next selected (or
+set by G10 L2), a written G28 position at the next G28.  Lengths are in the
+machine's units (rs274's are inches; gcodekit takes the tool table's units),
+the U V W slots are ordinary parameters.
+
 The parameter stage asks :func:`machine_parameter` only after the machine
 has run every line before the one reading (see ``gcodekit.pipeline``).
 
@@ -43,12 +53,34 @@ def _position(axis: int) -> Callable[["MachineState"], float]:
     return read
 
 
+def _machine_unit(machine: "Machine", axis: int) -> float:
+    """mm per machine unit on ``axis``: rs274 gives offsets in machine units (the tool table's), not the program's."""
+    return 25.4 if machine.config.tool_table_units == "inch" and axis < 3 else 1.0
+
+
 def _tool_offset(axis: int) -> Callable[["Machine"], float]:
-    # rs274 gives these in machine units (the tool table's), not the program's
     def read(m: "Machine") -> float:
-        per_unit = 25.4 if m.config.tool_table_units == "inch" and axis < 3 else 1.0
-        return float(m.state.tool_offset[axis] / per_unit) if axis < 6 else 0.0
+        return float(m.state.tool_offset[axis] / _machine_unit(m, axis)) if axis < 6 else 0.0
     return read
+
+
+def _stored_slot(key: int | str) -> tuple[str, int | tuple[int, int], int] | None:
+    """Where stored parameter ``key`` lives: (state attribute, index, axis); axis -1 for a rotation."""
+    if not isinstance(key, int):
+        return None
+    for first, attribute in ((5161, "home"), (5181, "home_secondary"), (5211, "g92_stored")):
+        if first <= key < first + 6:
+            return attribute, key - first, key - first
+    system, slot = divmod(key - 5221, 20)
+    if 0 <= system < 9 and slot < 6:
+        return "work_offsets", (system + 1, slot), slot
+    if 0 <= system < 9 and slot == 9:
+        return "rotations", system + 1, -1
+    return None
+
+
+def _scale(machine: "Machine", axis: int) -> float:
+    return _machine_unit(machine, axis) if axis >= 0 else 1.0
 
 
 def _feed(s: "MachineState") -> float:
@@ -88,12 +120,35 @@ _MACHINE_READERS: dict[int | str, Callable[["Machine"], float]] = {5401 + k: _to
 
 def is_state_parameter(key: int | str) -> bool:
     """Whether ``key`` (a number, or a normalized name) reports the machine's state."""
-    return key in _READERS or key in _MACHINE_READERS
+    return key in _READERS or key in _MACHINE_READERS or is_stored_parameter(key)
+
+
+def is_stored_parameter(key: int | str) -> bool:
+    """Whether ``key`` is a stored position or offset a program may write (``#5221 = 1``)."""
+    return key == 5210 or _stored_slot(key) is not None
 
 
 def machine_parameter(machine: "Machine", key: int | str) -> float | None:
     """The value of state parameter ``key`` on ``machine`` now; None for any other parameter."""
     if key in _MACHINE_READERS:
         return _MACHINE_READERS[key](machine)
+    if key == 5210:
+        return float(machine.state.g92_on)
+    slot = _stored_slot(key)
+    if slot is not None:
+        attribute, index, axis = slot
+        return float(getattr(machine.state, attribute)[index] / _scale(machine, axis))
     reader = _READERS.get(key)
     return None if reader is None else reader(machine.state)
+
+
+def set_machine_parameter(machine: "Machine", key: int | str, value: float) -> None:
+    """Write stored parameter ``key`` (see :func:`is_stored_parameter`) into the machine."""
+    if key == 5210:
+        machine.state.g92_on = value != 0.0
+        return
+    slot = _stored_slot(key)
+    if slot is None:
+        raise KeyError(key)
+    attribute, index, axis = slot
+    getattr(machine.state, attribute)[index] = value * _scale(machine, axis)

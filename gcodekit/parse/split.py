@@ -64,11 +64,13 @@ _RANK_OTHER_M = 13
 _RANK_OTHER_G = 22
 
 #: RS274NGC's modal groups (LinuxCNC 2.9 "Modal Groups"; group 1, motion, is
-#: checked on its own), by normalized command.  Group 0 holds the non-modal codes.
+#: checked on its own), by normalized command.  Group 0 holds the non-modal
+#: codes; rs274 2.9 lets G92.1/G92.2/G92.3 share a block with one of them.
 _MODAL_GROUPS = {
     **dict.fromkeys(("dwell", "coordinate_data", "home", "home_secondary", "store_home", "store_home_secondary",
-                     "machine_coordinates", "set_position", "clear_position_offset", "suspend_position_offset",
-                     "restore_position_offset", "local_offset"), "non-modal"),
+                     "machine_coordinates", "set_position", "local_offset"), "non-modal"),
+    **dict.fromkeys(("clear_position_offset", "suspend_position_offset", "restore_position_offset"),
+                    "G92 offset switch"),
     **dict.fromkeys(("plane_xy", "plane_zx", "plane_yz"), "plane"),
     **dict.fromkeys(("distance_absolute", "distance_incremental"), "distance mode"),
     **dict.fromkeys(("arc_distance_absolute", "arc_distance_incremental"), "arc distance mode"),

@@ -14,7 +14,7 @@ import dataclasses
 import operator
 import re
 from decimal import Decimal
-from typing import TYPE_CHECKING, Callable, Iterable, Iterator, Sequence
+from typing import TYPE_CHECKING, Callable, Iterable, Iterator, Protocol, Sequence
 
 from gcodekit.errors import Diagnostics, GcodeError, GcodeExpressionError, GcodeLimitError
 from gcodekit.preprocess.expressions import (
@@ -43,6 +43,16 @@ CALL_PARAMETERS = 30
 #: ``system(key)`` gives a read-only system parameter (``5420``, ``"_x"``)
 #: or None when ``key`` is not one.
 SystemParameters = Callable[[int | str], float | None]
+
+
+class SystemWrites(Protocol):
+    """System parameters a program may write (LinuxCNC's ``#5221``, a stored work offset)."""
+
+    def writable(self, key: int | str) -> bool:
+        """Whether ``key`` is one."""
+
+    def write(self, key: int | str, value: float) -> None:
+        """Store ``value`` where the machine keeps ``key``."""
 
 O_WORD_MESSAGE = "O-word control flow is not supported yet (issue #4)"
 
@@ -100,9 +110,10 @@ class ParameterStore:
     Parameters
     ----------
     system : callable, default: None
-        ``system(key)`` returns the value of a read-only system parameter or
-        None; see :data:`SystemParameters`.  A later machine stage supplies
-        it (current position ``#5420``, ...).
+        ``system(key)`` returns the value of a system parameter or None; see
+        :data:`SystemParameters`.  A later machine stage supplies it (current
+        position ``#5420``, ...).  System parameters are read-only unless
+        ``system_writes`` takes them (:class:`SystemWrites`).
 
     Examples
     --------
@@ -112,11 +123,12 @@ class ParameterStore:
     (2.5, 0.0, False)
     """
 
-    def __init__(self, *, system: SystemParameters | None = None):
+    def __init__(self, *, system: SystemParameters | None = None, system_writes: SystemWrites | None = None):
         self._numbered = [0.0] * (MAX_PARAMETER + 1)
         self._globals: dict[str, float] = {}
         self._locals: dict[str, float] = {}
         self._system = system
+        self._system_writes = system_writes
         # One (caller's named locals, caller's #1..#30 or None) per open call.
         self._calls: list[tuple[dict[str, float], list[float] | None]] = []
 
@@ -151,6 +163,9 @@ class ParameterStore:
         key = _normalize(key)
         if isinstance(key, int):
             _check_number(key)
+        if self._system_writes is not None and self._system_writes.writable(key):
+            self._system_writes.write(key, float(value))
+            return
         if self.read_only(key):
             raise GcodeExpressionError(f"parameter {_show(key)} is read-only")
         if isinstance(key, int):
@@ -166,8 +181,11 @@ class ParameterStore:
         return self.read_only(key) or key in self._scope(key)
 
     def read_only(self, key: int | str) -> bool:
-        """Whether ``key`` is a system parameter (which :meth:`set` refuses)."""
-        return self._system is not None and self._system(_normalize(key)) is not None
+        """Whether ``key`` is a system parameter :meth:`set` refuses."""
+        key = _normalize(key)
+        if self._system_writes is not None and self._system_writes.writable(key):
+            return False
+        return self._system is not None and self._system(key) is not None
 
     @contextlib.contextmanager
     def overlay(self, system: SystemParameters):
