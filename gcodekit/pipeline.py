@@ -32,6 +32,7 @@ from .memory import release_freed_memory
 from .parse import CommandTable, GcodeParser
 from .parse.table import NAME_ID
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
+from .read.percent import closing_percent_index, until_closing_percent
 from .syntax import Flavor, detect_flavor, load_flavor
 
 if TYPE_CHECKING:
@@ -40,6 +41,7 @@ if TYPE_CHECKING:
 __all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate_operation", "resolve"]
 
 _O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
+_SUBPROGRAM_M = re.compile(r"(?i)m\s*0*9\s*[89](?![\s.]*\d)")  # M98/M99: Fanuc-style subprogram flow
 _PROBE_LINE = re.compile(r"(?i)g\s*0*3\s*8\s*\.\s*[2-5]")  # G38.2 .. G38.5 in a preprocessed line
 _PROBE_RESULTS = range(5061, 5071)
 #: Line numbers from here up stand for lines of subroutine files (see _number_other_files)
@@ -268,7 +270,7 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         feedback = _MachineFeedback(flavor, diagnostics, *machine) if machine is not None else None
         store = ParameterStore(system=feedback.system, system_writes=feedback) if feedback is not None else None
         stages = [ControlFlowStage(flavor, store, search_path=search_path)] if flavor.parameters and (
-            needs_parameters(text) or _O_WORD_LINE.search(text)) else []
+            needs_parameters(text) or _O_WORD_LINE.search(text) or _SUBPROGRAM_M.search(text)) else []
         if not stages:
             feedback = None  # no parameters for the machine to give
         stages += [WizardStage(flavor)] if flavor.wizards and needs_wizards(text) else []
@@ -277,6 +279,9 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
             lines = text.split("\n")
             if lines and lines[-1] == "":
                 lines.pop()
+            closing = closing_percent_index(lines) if flavor.percent_delimiter else None
+            if closing is not None:
+                del lines[closing + 1:]  # never read, as in rs274
             source = (SourceLine(t.rstrip("\r"), k + 1, program.name) for k, t in enumerate(lines))
             if diagnostics.mode == "strict":
                 # The interpreter runs a line at a time: a line before the first
@@ -298,6 +303,8 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         chunks: Iterator[bytes] = iter_lines(text)
     else:
         chunks = program.chunks()
+    if flavor.percent_delimiter:
+        chunks = until_closing_percent(chunks)
     sizes: list[int] = []
 
     def counted():

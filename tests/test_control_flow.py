@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import gcodekit
 from gcodekit.errors import Diagnostics, GcodeError, GcodeLimitError, GcodeSyntaxError
 from gcodekit.preprocess import ControlFlowStage, ParameterStore, SourceLine
 from gcodekit.syntax import load_flavor
@@ -314,6 +315,20 @@ def test_fanuc_m98_l0_and_unknown_program():
     assert texts("M98 P1 L0\nG0 X1\nM30\nO1\nG0 X9\nM99", flavor=FANUC) == ["G0 X1", "M30"]
     with pytest.raises(GcodeError, match="unknown program o77"):
         run("M98 P77", flavor=FANUC)
+
+
+def test_subprograms_called_in_the_other_style_are_reported_at_their_definition():
+    # rs274 2.9 (tests/interp m98m99/06-error-mixed-sub-styles) reports these where the sub begins
+    with pytest.raises(GcodeError, match=r"t.ngc:4:1: .*o1 must be called with M98.*called on line 1"):
+        run("o1 call\nM30\n%\nO1\nG0 X1\nM99", flavor=load_flavor("rs274ngc"))
+    with pytest.raises(GcodeError, match=r"t.ngc:4:1: error: 'o1 sub' must be called with 'o1 call'.*called on line 1"):
+        run("M98 P1\nM30\n%\no1 sub\nG0 X1\no1 endsub", flavor=load_flavor("rs274ngc"))
+
+
+def test_m98_alone_runs_the_subprogram_stage():
+    # a program whose only flow is M98 still gets its subprograms (no O-word line starts it)
+    op = gcodekit.gcode_to_operation("G21\nM98 P5\nM30\n", "linuxcnc", plan=False)
+    assert ["call of unknown program o5" in d.message for d in op.diagnostics.items] == [True]
 
 
 def test_m99_in_the_main_program_ends_it_with_a_warning():

@@ -125,3 +125,20 @@ def test_strict_mode_raises_with_location():
     d = info.value.diagnostic
     assert (d.line, d.column) == (2, 5)
     assert "<string>:2:5" in str(info.value)
+
+
+@pytest.mark.parametrize("body", ["G0 X1", "#1 = 1\nG0 X#1"])  # read in chunks, or line by line by the preprocessor
+def test_nothing_after_the_closing_percent_is_read(tmp_path, body):
+    import gcodekit
+
+    path = tmp_path / "p.ngc"
+    path.write_text(f"%\n{body}\n%\n(notes (with a nested comment))\nG0 X9 Q\no2 sub\no2 endsub\n")
+    op = gcodekit.gcode_to_operation(path, "linuxcnc", plan=False)
+    assert not op.diagnostics.items
+    assert op.motions()["x"].tolist() == [1.0]
+
+
+def test_a_nested_comment_is_one_error():
+    blocks = read_text("G0 X1 (a (b) c) Y2\n", flavor="rs274ngc")
+    assert [(d.column, d.message) for d in blocks.diagnostics.items] == [(7, "nested comment")]
+    assert [w.letter for w in blocks[0].words] == ["G", "X", "Y"]

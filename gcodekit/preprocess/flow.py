@@ -236,7 +236,7 @@ class _Run:
         for name in ("_value", "_value_returned"):
             if not self.store.exists(name):
                 self._set(name, 0.0)
-        self.code = self._link(_Code(file, [self._statement(s) for s in lines]))
+        self.code = self._link(_Code(file, [self._statement(s) for s in lines]), main=True)
         try:
             while True:
                 items = self.code.items
@@ -435,6 +435,15 @@ class _Run:
                         break
         if label in table:
             return table[label]
+        calling = st.line.line if isinstance(st, OWord) else st.line
+        other = self.programs if table is self.subs else self.subs
+        if label in other:  # defined in the other style: rs274 reports it at the definition
+            code, i = other[label]
+            item = code.items[i]
+            message = (f"Fanuc-style program o{label} must be called with M98, not 'o{label} call'" if table is self.subs
+                       else f"'o{label} sub' must be called with 'o{label} call', not M98")
+            self._report(item.line if isinstance(item, OWord) else item, 1, f"{message} (called on line {calling})")
+            return None
         what = "subroutine" if table is self.subs else "program"
         known = [f"o{k}" for k in table]
         hint = did_you_mean(f"o{label}", known)
@@ -445,7 +454,7 @@ class _Run:
             # rs274 looks for the sub down to the end of the file and reports the error there
             last = self.code.items[-1]
             line, column = (last.line if isinstance(last, OWord) else last), 1
-            called += f" (called on line {st.line.line if isinstance(st, OWord) else st.line})"
+            called += f" (called on line {calling})"
         message = f"call of unknown {what} {called}: not in the program nor as {label.strip('<>')}.ngc in {where}{hint}"
         self._report(line, column, message)
         return None
@@ -674,15 +683,37 @@ class _Run:
 
     # -- matching ------------------------------------------------------------
 
-    def _link(self, code: _Code) -> _Code:
-        """Match the O-words of one file and register its subs and programs."""
+    @staticmethod
+    def _program_title(items: list) -> int | None:
+        """Index of a program-number O-word (``O1``) that opens the file before any code, else None."""
+        for i, st in enumerate(items):
+            if isinstance(st, OWord):
+                return i if st.keyword == "" and st.valid else None
+            if st.text.strip() and not st.text.strip().startswith(("(", ";", "%")):
+                return None
+        return None
+
+    def _link(self, code: _Code, main: bool = False) -> _Code:
+        """Match the O-words of one file and register its subs and programs.
+
+        A main program titled with a program number (``O1`` first) must end
+        (M2/M30) before its first ``o- sub``, as rs274 requires.
+        """
         items = code.items
         stack: list[int] = []
         branches: dict[int, list[int]] = {}
+        title = self._program_title(items) if main else None
         for i, st in enumerate(items):
+            if title is not None and not isinstance(st, OWord) and (flow := _MAYBE_FLOW_M.search(st.text) and
+                                                                   self._flow_m(st.text)) and flow[0] in (2, 30):
+                title = None  # the titled main program has ended
             if not isinstance(st, OWord) or not st.valid:
                 continue
             k = st.keyword
+            if k == "sub" and title is not None and i > title:
+                self._report(st.line, st.column, f"{st.name} found in an illegal location: the main program "
+                             f"{items[title].name} must end with M2 or M30 before its subroutines")
+                title = None
             if k == "sub":
                 if stack:
                     self._report(st.line, st.column, f"{st.name} inside {items[stack[-1]].name}: "

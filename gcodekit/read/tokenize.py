@@ -159,8 +159,10 @@ class LineTokenizer:
             block.comments.append((text[i + 1 :].strip(), i + 1))
             return len(text)
         body = text[i + 1 : end]
-        if "(" in body:
+        if "(" in body:  # an error; the comment then runs to its matching ')' (or the line's end)
             self.diagnostics.report(block.line, i + 1, "nested comment", text)
+            end = _matching_paren(text, i)
+            body = text[i + 1 : end]
         block.comments.append((body.strip(), i + 1))
         return end + 1
 
@@ -309,3 +311,13 @@ class LineTokenizer:
         while j < len(text) and not (text[j].isalpha() or text[j] in _SPACE or text[j] in self.flavor.line_comments or text[j] == "("):
             j += 1
         return j
+
+
+def _matching_paren(text: str, start: int) -> int:
+    """Index of the ')' closing the '(' at ``start``, counting nested pairs; the line's end if none."""
+    depth = 0
+    for k in range(start, len(text)):
+        depth += {"(": 1, ")": -1}.get(text[k], 0)
+        if depth == 0:
+            return k
+    return len(text)
