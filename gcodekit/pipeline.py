@@ -206,7 +206,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     reading_error = None
     try:
         for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate),
-                                     search_path=config.subroutine_path):
+                                     search_path=config.subroutine_path + (m.ini.subroutine_path if m.ini else ())):
             emulate(blocks, lines)
     except GcodeError as exc:  # strict mode: raised below unless a line run before it failed
         reading_error = exc

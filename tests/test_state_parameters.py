@@ -75,3 +75,20 @@ def test_stored_g92_offset_and_home_positions():
     # G28 goes through the current point (no length) to the position written in #5161..
     op = run("G21\nG0 X1 Y1\n#5161 = 7\n#5162 = 8\nG28\nM2\n")
     assert [tuple(p) for p in zip(moves(op, "x"), moves(op, "y"))] == [(1, 1), (1, 1), (7, 8)]
+
+
+def test_ini_values_and_subroutine_path(tmp_path):
+    (tmp_path / "subs").mkdir()
+    (tmp_path / "subs" / "park.ngc").write_text("o<park> sub\nG0 X#<_ini[vars]park_x>\no<park> endsub\n")
+    ini = tmp_path / "machine.ini"
+    ini.write_text("[VARS]\nPARK_X = 12.5\n# a comment\nPARK_X = 99\n[RS274NGC]\nSUBROUTINE_PATH = subs\n")
+    program = tmp_path / "p.ngc"
+    program.write_text("G21 G0 Y#<_InI[Vars]Park_X>\no<park> call\nM2\n")
+    op = gcodekit.gcode_to_operation(program, "linuxcnc", plan=False, ini_file=str(ini))
+    assert not op.diagnostics.items
+    assert moves(op, "y") == [12.5, 12.5] and moves(op, "x") == [0.0, 12.5]  # the first PARK_X wins
+    op = run("#<_ini[vars]park_x> = 1\nG0 X#<_ini[vars]nothing>\nM2\n", ini_file=str(ini))
+    assert [(d.line, "read-only" in d.message or "not defined" in d.message) for d in op.diagnostics.items
+            if d.severity == "error"] == [(1, True), (2, True)]
+    with pytest.raises(gcodekit.ConfigError, match="cannot read the INI file"):
+        run("G0 X1\n", ini_file=str(tmp_path / "missing.ini"))

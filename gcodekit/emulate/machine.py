@@ -23,6 +23,7 @@ from ..parse.commands import Kind
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, MOTION_THREAD, NAME_ID,
                            SPLINE_MOTIONS, CommandTable)
 from . import arcs
+from .ini import LinuxCncIni
 from .modal import ModalHandler, Waypoint
 from .presets import MachineConfig
 from .state import AXES, MachineState
@@ -107,6 +108,7 @@ class Machine:
             self.state.work_offsets[_WORK_INDEX[code], : len(vector)] = vector
         self.state.select_work_system(1)
         self.tools = ToolTable.read(config.tool_table, units=config.tool_table_units) if config.tool_table else ToolTable()
+        self.ini = LinuxCncIni.read(config.ini_file) if config.ini_file else None
         for number, text in self.tools.skipped[:20]:
             self.diagnostics.report(number, 1, "tool table line without a T word skipped (as LinuxCNC does)", text,
                                     severity="warning", file=self.tools.source)

@@ -110,6 +110,10 @@ class MachineConfig:
         Directories searched, after the program's own, for the subroutine
         files a program calls by name (``o<name> call``), like LinuxCNC's
         ``[RS274NGC] SUBROUTINE_PATH``; a string is split at ``:``.
+    ini_file : str
+        A LinuxCNC INI file: a program reads its values as
+        ``#<_ini[SECTION]NAME>``, and its ``[RS274NGC] SUBROUTINE_PATH``
+        is searched after ``subroutine_path``.
     dwell_s_seconds : bool
         ``G4 S`` is a dwell in seconds (Marlin, RepRapFirmware); Klipper
         ignores S.
@@ -159,6 +163,7 @@ class MachineConfig:
     tool_table: str = ""
     tool_table_units: str = "mm"
     subroutine_path: tuple[str, ...] = ()
+    ini_file: str = ""
     dwell_s_seconds: bool = True
     planner: str = ""
     planner_settings: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))

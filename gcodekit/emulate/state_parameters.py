@@ -18,6 +18,9 @@ set by G10 L2), a written G28 position at the next G28.  Lengths are in the
 machine's units (rs274's are inches; gcodekit takes the tool table's units),
 the U V W slots are ordinary parameters.
 
+With the machine option ``ini_file``, ``#<_ini[SECTION]NAME>`` reads the
+INI file's value (read-only; see :mod:`.ini`).
+
 The parameter stage asks :func:`machine_parameter` only after the machine
 has run every line before the one reading (see ``gcodekit.pipeline``).
 
@@ -119,8 +122,9 @@ _MACHINE_READERS: dict[int | str, Callable[["Machine"], float]] = {5401 + k: _to
 
 
 def is_state_parameter(key: int | str) -> bool:
-    """Whether ``key`` (a number, or a normalized name) reports the machine's state."""
-    return key in _READERS or key in _MACHINE_READERS or is_stored_parameter(key)
+    """Whether ``key`` (a number, or a normalized name) reports the machine's state or configuration."""
+    return (key in _READERS or key in _MACHINE_READERS or is_stored_parameter(key)
+            or (isinstance(key, str) and key.startswith("_ini[")))
 
 
 def is_stored_parameter(key: int | str) -> bool:
@@ -134,6 +138,8 @@ def machine_parameter(machine: "Machine", key: int | str) -> float | None:
         return _MACHINE_READERS[key](machine)
     if key == 5210:
         return float(machine.state.g92_on)
+    if isinstance(key, str) and key.startswith("_ini["):  # an INI value: None when the file has none
+        return machine.ini.parameter(key) if machine.ini is not None else None
     slot = _stored_slot(key)
     if slot is not None:
         attribute, index, axis = slot

@@ -70,7 +70,7 @@ def check(program: Path, workdir: Path) -> tuple[str, str]:
     subprocess.run(["/usr/bin/python3", str(SHARED_TOOLS / "canon_to_csv.py"), str(canon), "-o", str(csv),
                     "--src", str(program)], capture_output=True, text=True)
     op = gcodekit.gcode_to_operation(program, machine="linuxcnc", plan=False, tool_table=str(table or DEFAULT_TABLE),
-                                     tool_table_units="inch", units_keep_feed=True)
+                                     tool_table_units="inch", units_keep_feed=True, ini_file=str(ini or ""))
     errors = [d for d in op.diagnostics.items if d.severity == "error"]
     shown = [str(d) for d in errors[:2]]
     if rs274.returncode != 0:
