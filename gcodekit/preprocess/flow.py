@@ -450,8 +450,8 @@ class _Run:
         where = ", ".join(str(d) for d in self.directories) or "no search path"
         line, column = (st.line, st.column) if isinstance(st, OWord) else (st, 1)
         called = f"o{label}"
-        if table is self.subs and self.code.items:
-            # rs274 looks for the sub down to the end of the file and reports the error there
+        if self.code.items:
+            # rs274 looks for the sub or program down to the end of the file and reports the error there
             last = self.code.items[-1]
             line, column = (last.line if isinstance(last, OWord) else last), 1
             called += f" (called on line {calling})"

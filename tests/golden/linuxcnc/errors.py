@@ -76,6 +76,8 @@ def expected_line(program: Path, message: str, block: str) -> tuple[int | None, 
     hits = [k + 1 for k, text in enumerate(lines) if squash(text) == squash(block)]
     if len(hits) == 1:
         return hits[0], "the only line with the block text"
+    if hits and "before EOF" in message:  # rs274 searched for a subprogram down to the end of the file
+        return hits[-1], "last line with the block text (the search ran to the end of the file)"
     after = last_motion_line(program.with_name(program.name + ".canon.csv"))
     later = [k for k in hits if k > after]
     if later:
