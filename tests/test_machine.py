@@ -346,6 +346,17 @@ def test_g10_l20_under_a_rotation_moves_the_origin_along_both_axes():
     assert [(d.line, d.message) for d in op.diagnostics.items] == [(2, "R not allowed in G10 L20")]
 
 
+def test_tool_table_lines_rs274_cannot_read_are_skipped(tmp_path):
+    # rs274 2.9 skips a line without T, or with a word it lacks (a newer table's WX wear offset, K):
+    # selecting such a tool is then "Requested tool 2 not found in the tool table"
+    table = tmp_path / "tools.tbl"
+    table.write_text("T1 P1 Z1.0\nT2 P2 X3.0 Z4.0 WX0.05 WZ-0.03\nP3 Z1\nT4 P4 Z1 K5 ;note\nT5 P5 Z2 Q9 ;lathe\n")
+    op, _ = run("G20\nT2 M6\nT5 M6\nM2\n", tool_table=table, tool_table_units="inch")
+    found = [(d.file.endswith("tools.tbl"), d.line, d.severity) for d in op.diagnostics.items]
+    assert found == [(True, 2, "warning"), (True, 3, "warning"), (True, 4, "warning"), (False, 2, "error")]
+    assert "Requested tool 2 not found" in op.diagnostics.items[-1].message
+
+
 def test_g92_leaves_the_tool_length_offset_out_of_its_offset(tmp_path):
     # program Z 10 with a 12.7 mm tool is machine Z 22.7; G92 Z0 makes the offset 10, so Z-1 is machine 21.7
     table = tmp_path / "tools.tbl"

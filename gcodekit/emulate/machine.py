@@ -109,8 +109,8 @@ class Machine:
         self.state.select_work_system(1)
         self.tools = ToolTable.read(config.tool_table, units=config.tool_table_units) if config.tool_table else ToolTable()
         self.ini = LinuxCncIni.read(config.ini_file) if config.ini_file else None
-        for number, text in self.tools.skipped[:20]:
-            self.diagnostics.report(number, 1, "tool table line without a T word skipped (as LinuxCNC does)", text,
+        for number, text, reason in self.tools.skipped[:20]:
+            self.diagnostics.report(number, 1, f"tool table line skipped, as LinuxCNC does: {reason}", text,
                                     severity="warning", file=self.tools.source)
         self.modal = ModalHandler(self)
         self._straight_ids = np.array([NAME_ID["rapid"], NAME_ID["linear"]], np.uint8)

@@ -23,6 +23,8 @@ import numpy as np
 from ..errors import ConfigError
 
 _WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
+#: A line rs274 2.9 reads: only these letters, each with a number (it skips one with ``WX0.05`` or ``K5``)
+_LINE = re.compile(r"\s*(?:[TPXYZABCUVWDIJQ]\s*[-+]?(?:\d+\.?\d*|\.\d+)\s*)*", re.IGNORECASE)
 _AXES = "XYZABC"
 
 
@@ -46,12 +48,13 @@ class Tool:
 class ToolTable(dict):
     """Tools by number, with lengths in mm.
 
-    ``skipped`` lists the lines without a T word, ``(line number, text)``:
-    LinuxCNC skips them with a warning (an old-format table's lines, for one).
+    ``skipped`` lists the lines LinuxCNC skips, ``(line number, text,
+    reason)``: lines without a T word (an old-format table's, for one) and
+    lines with a word it does not know.
     """
 
     source = "<tool table>"
-    skipped: list[tuple[int, str]]
+    skipped: list[tuple[int, str, str]]
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
@@ -70,8 +73,11 @@ class ToolTable(dict):
             if not body.strip():
                 continue
             words = {k.upper(): float(v) for k, v in _WORD.findall(body)}
+            if not _LINE.fullmatch(body):
+                table.skipped.append((number, raw.strip(), "a word LinuxCNC's tool table does not have"))
+                continue
             if "T" not in words:
-                table.skipped.append((number, raw.strip()))
+                table.skipped.append((number, raw.strip(), "no T word"))
                 continue
             offset = np.array([words.get(a, 0.0) * (scale if a in "XYZ" else 1.0) for a in _AXES])
             tool = Tool(int(words["T"]), int(words.get("P", 0)), offset, words.get("D", 0.0) * scale,
