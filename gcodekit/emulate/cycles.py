@@ -15,7 +15,13 @@ Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
   hole (even when already there; under G98 at the clear height), rapid down to R if above it, the cycle's
   own moves, then a rapid retract to the clear height: the old Z (G98, if
   that is above R) or R (G99).
-* G84 and G74 feed out again (the spindle reversed); G88 stops at the bottom for a
+* G84 and G74 feed out again (the spindle reversed).  Outside G17 rs274 2.9
+  sends these two feeds with the axes mixed up: in G18 to (level, hole Z,
+  hole X), in G19 to (hole Z, level, hole Y) as X Y Z (LinuxCNC's own
+  tests/interp g84 output keeps it); gcodekit moves the same way, and
+  rs274's idea of where the tool is afterwards stays the right one
+  (:attr:`CycleMoves.end`).
+* G88 stops at the bottom for a
   manual retract, so the cycle itself never leaves the hole; G87 steps aside
   by I/J, drops below the part, bores up to K (G91: K from Z) and back, then
   leaves the way it came.
@@ -31,6 +37,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -39,6 +46,16 @@ from .arcs import PLANES
 
 CYCLES = frozenset(CYCLE_NAMES)
 PECK_DELTA_MM = 0.254  # LinuxCNC's G73/G83 back-off and approach, 0.010 in
+
+
+TAPPING = ("cycle_tap", "cycle_tap_left")
+
+
+class CycleMoves(NamedTuple):
+    """The moves of a cycle block and the program point (mm) the interpreter then takes as current."""
+
+    steps: list["Step"]
+    end: np.ndarray
 
 
 @dataclass
@@ -70,7 +87,7 @@ class CycleState:
 
 def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray,
               to_machine: Callable[[np.ndarray], np.ndarray], scale: np.ndarray, plane: int, incremental: bool,
-              dwell_unit: float) -> list[Step]:
+              dwell_unit: float) -> CycleMoves:
     """Moves of one canned-cycle block (``params`` as written, in program units).
 
     The cycle works in program coordinates (mm) from ``program``, the
@@ -101,7 +118,7 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
         raise ValueError(f"canned cycle needs R and {letter} (none in force)")
     repeats = int(params.get("L", 1))
     if repeats < 1:
-        return []
+        return CycleMoves([], program.copy())
     if cycle.initial is None:
         cycle.initial = program.copy()
     old = cycle.initial[axis]  # the level where the cycle mode began, program coordinates (mm)
@@ -117,6 +134,12 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
     def go(coord: float, motion: int, dwell: float = 0.0) -> None:
         here[axis] = coord
         steps.append(Step(to_machine(here), motion, dwell))
+
+    def tap_feed(coord: float) -> None:  # G74/G84 outside G17, as rs274 2.9 sends it (see the module doc)
+        here[axis] = coord
+        sent = here.copy()
+        sent[[0, 1, 2]] = (coord, here[2], here[0]) if plane == 18 else (here[2], coord, here[1])
+        steps.append(Step(to_machine(sent), MOTION_LINEAR))
 
     def slide(aside: bool) -> None:  # G87: rapid to the side step off the hole centre, or back
         here[[a, b]] = target[[a, b]] + (cycle.shift if aside else 0.0)
@@ -139,9 +162,12 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
             go(r, MOTION_RAPID)
         if cycle.name == "cycle_back_bore":
             _back_bore(bottom + cycle.k if incremental else cycle.k, bottom, clear, go, slide)  # G91: K from Z
+        elif cycle.name in TAPPING and plane != 17:
+            tap_feed(bottom)
+            tap_feed(clear)
         else:
             _drill(cycle, r, bottom, clear, go)
-    return steps
+    return CycleMoves(steps, here)
 
 
 def _back_bore_words(cycle: CycleState, params: dict, plane: int, scale: np.ndarray) -> None:

@@ -19,7 +19,7 @@ from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, M
                            MOTION_THREAD, NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
 from ..parse.commands import Kind
 from .arcs import PLANES, center_from_radius, reach_tolerance, single_turn_lengths
-from .cycles import CYCLES, polar_target, run_cycle
+from .cycles import CYCLES, TAPPING, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
 from .splines import SPLINE_NAMES, SplineBlocks
@@ -99,6 +99,7 @@ class ModalHandler:
         self._cycle_name = ""  # the canned cycle whose mode is in force (axis words alone repeat it)
         self._thread_name = "thread"  # G33 or G33.1: which one axis words alone repeat
         self._lathe_motion = MOTION_LINEAR  # the mode a lathe cycle's last move left in force
+        self._believed: np.ndarray | None = None  # program point rs274 takes a cycle to end at
 
     @property
     def state(self) -> MachineState:
@@ -248,6 +249,9 @@ class ModalHandler:
                 return extra
         if motion != MOTION_NONE:
             s.program_shift[:] = 0.0  # the machine has reached the offsets in force
+        if self._believed is not None:
+            s.keep_program_position(self._believed)
+            self._believed = None
         for w in extra:
             self._fill_passing(w, before)
             before = np.array([w.values[k] for k in AXES.lower()])
@@ -276,7 +280,7 @@ class ModalHandler:
         s = self.state
         unit = 0.001 if self.machine.config.dwell_p_unit == "ms" else 1.0
         try:
-            steps = run_cycle(name if name in CYCLES else "", params, s.cycle,
+            steps, end = run_cycle(name if name in CYCLES else "", params, s.cycle,
                               program=s.program_position(), to_machine=s.to_machine, scale=s.scale(), plane=s.plane,
                               incremental=s.incremental, dwell_unit=unit)
         except ValueError as exc:
@@ -288,9 +292,13 @@ class ModalHandler:
             return MOTION_NONE, []
         if not steps:
             return MOTION_NONE, []
+        if s.cycle.name in TAPPING and s.plane != 17:
+            self.machine._once("tapping outside G17", line, f"G74/G84 in G{s.plane}: the feeds move as LinuxCNC 2.9 "
+                               "sends them, with the axes mixed up (see gcodekit.emulate.cycles)")
         extra = [Waypoint({**dict(zip(AXES.lower(), st.point)), "motion": st.motion, "dwell": st.dwell})
                  for st in steps[:-1]]
         s.position = steps[-1].point.copy()
+        self._believed = end  # where rs274 takes the tool to be (see cycles.TAPPING): kept after the block
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
 
