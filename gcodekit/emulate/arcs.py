@@ -58,6 +58,24 @@ def center_from_radius(start: np.ndarray, end: np.ndarray, radius: np.ndarray, c
     return center, reach
 
 
+def centres(start: np.ndarray, end: np.ndarray, offsets: np.ndarray, radius: np.ndarray, clockwise: np.ndarray,
+            incremental: bool) -> tuple[np.ndarray, np.ndarray]:
+    """In-plane centres of arcs given by I/J/K offsets or by R, as the program gives them.
+
+    ``offsets`` (n, 2) are the two centre words (NaN: not given, taken as 0),
+    from the start (``incremental``, G91.1) or absolute (G90.1); a radius
+    (NaN where none) overrides them.  Also returns how far each R-form arc
+    falls short of its end (see :func:`reach_tolerance`; 0 for the others).
+    """
+    centre = np.nan_to_num(offsets) + (start if incremental else 0.0)
+    short = np.zeros(len(start))
+    by_radius = ~np.isnan(radius)
+    if by_radius.any():
+        centre[by_radius], short[by_radius] = center_from_radius(start[by_radius], end[by_radius], radius[by_radius],
+                                                                 clockwise[by_radius])
+    return centre, short
+
+
 def sweep(start: np.ndarray, end: np.ndarray, center: np.ndarray, clockwise: np.ndarray,
           turns: np.ndarray, full_circle_tolerance: float = 1e-9) -> np.ndarray:
     """Swept angle of each arc in radians (positive, includes extra turns).

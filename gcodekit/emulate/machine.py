@@ -412,20 +412,14 @@ class Machine:
         o1 = _take(t, l1, rows) * s.units
         o2 = _take(t, l2, rows) * s.units
         clockwise = t.motion[rows] == MOTION_CW
-        by_radius = ~np.isnan(r_word)
-        no_center = ~by_radius & np.isnan(o1) & np.isnan(o2)
+        no_center = np.isnan(r_word) & np.isnan(o1) & np.isnan(o2)
         for i in np.flatnonzero(no_center)[:20]:
             self.diagnostics.report(int(t.line[rows[i]]), 1, f"arc needs {l1}/{l2} offsets or R in this plane (G{s.plane})",
                                     kind="machine")
-        center = np.column_stack([np.nan_to_num(o1), np.nan_to_num(o2)])
-        if s.arc_incremental:
-            center += p0
-        if by_radius.any():
-            c, reach = arcs.center_from_radius(p0[by_radius], p1[by_radius], r_word[by_radius], clockwise[by_radius])
-            center[by_radius] = c
-            for i in np.flatnonzero(by_radius)[reach > arcs.reach_tolerance(s.units)][:20]:
-                self.diagnostics.report(int(t.line[rows[i]]), 1, "arc radius too small to reach the end point",
-                                        kind="machine")
+        center, short = arcs.centres(p0, p1, np.column_stack([o1, o2]), r_word, clockwise, s.arc_incremental)
+        for i in np.flatnonzero(short > arcs.reach_tolerance(s.units))[:20]:
+            self.diagnostics.report(int(t.line[rows[i]]), 1, "arc radius too small to reach the end point",
+                                    kind="machine")
         turns = np.nan_to_num(_take(t, "P", rows), nan=1.0)
         angle = arcs.sweep(p0, p1, center, clockwise, turns)
         radius = np.hypot(*(p0 - center).T)

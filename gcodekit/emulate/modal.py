@@ -18,7 +18,7 @@ import numpy as np
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_RAPID,
                            MOTION_THREAD, NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
 from ..parse.commands import Kind
-from .arcs import PLANES, center_from_radius, reach_tolerance, single_turn_lengths
+from .arcs import PLANES, centres, reach_tolerance, single_turn_lengths
 from .cycles import CYCLES, TAPPING, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
@@ -350,18 +350,13 @@ class ModalHandler:
         (f, g, h), (l1, l2) = PLANES[s.plane]
         after = s.program_position()
         p0, p1 = before[[f, g]], after[[f, g]]
-        if "R" in params:
-            centre, reach = center_from_radius(p0[None], p1[None], np.array([params["R"] * s.units]),
-                                               np.array([clockwise]))
-            if reach[0] > reach_tolerance(s.units):
-                self.machine.diagnostics.report(line, 1, "arc radius too small to reach the end point",
-                                                kind="machine")
-            in_plane = centre[0]
-        else:
-            words = np.array([params.get(l1, 0.0), params.get(l2, 0.0)]) * s.units
-            in_plane = p0 + words if s.arc_incremental else words
+        words = np.array([[params.get(l1, np.nan), params.get(l2, np.nan)]]) * s.units
+        radius = np.array([params.get("R", np.nan) * s.units])
+        in_plane, short = centres(p0[None], p1[None], words, radius, np.array([clockwise]), s.arc_incremental)
+        if short[0] > reach_tolerance(s.units):
+            self.machine.diagnostics.report(line, 1, "arc radius too small to reach the end point", kind="machine")
         centre = after.copy()
-        centre[[f, g]] = in_plane
+        centre[[f, g]] = in_plane[0]
         centre = s.to_machine(centre)[:3]
         centre[h] = np.nan
         return tuple(centre)
