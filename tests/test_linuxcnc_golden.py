@@ -98,7 +98,10 @@ def first_difference(ours: pd.DataFrame, ref: pd.DataFrame, exact: list[str],
 
 
 def tool_table(name: str) -> Path:
-    """The tool table rs274 ran the case with (TOOLTABLE_OVERRIDES.tsv, else tool.tbl)."""
+    """The tool table rs274 ran the case with (its own ``.tbl`` beside it, TOOLTABLE_OVERRIDES.tsv, else tool.tbl)."""
+    own = (CASES / name).with_suffix(".tbl")
+    if own.exists():
+        return own
     tables = CASES.parent / "tooltables"
     for line in (tables / "overrides.tsv").read_text().splitlines():
         program, _, table = line.partition("\t")

@@ -218,6 +218,7 @@ class ModalHandler:
             s.coolant = {"coolant_mist": s.coolant | 1, "coolant_flood": s.coolant | 2, "coolant_off": 0}[name]
         elif name.startswith("cutter_comp_"):
             s.compensating = name != "cutter_comp_off"
+            s.compensating_left = name.startswith("cutter_comp_left")
         elif name == "program_end":
             self._end_program()
         elif name in ("tool_length_offset", "tool_length_offset_add"):

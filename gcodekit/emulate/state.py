@@ -81,6 +81,7 @@ class MachineState:
     laser: int = 0  # heat source (DED laser or weld arc) on
     retracted: bool = False  # firmware retraction (G10) in effect
     compensating: bool = False  # G41/G42 in force (the path is offset by a later pass)
+    compensating_left: bool = False  # ... and on the left (G41, G41.1)
     cycle: CycleState = field(default_factory=CycleState)  # canned-cycle words in force
     ended: bool = False  # M2/M30 reached: later blocks are not run
 

@@ -4,8 +4,9 @@ A program may read where the tool is and which modes are in force:
 ``#5420``-``#5428`` and ``#<_x>`` .. ``#<_w>`` (position in program units,
 every offset applied), ``#5220`` and ``#<_coord_system>`` (the work
 coordinate system), ``#5400`` (the tool in the spindle), ``#5401``-``#5409``
-(its length offsets) and the predefined named parameters of LinuxCNC 2.9
-(``#<_imperial>``, ``#<_plane>``, ``#<_feed>``, ``#<_rpm>``, ...).  Their
+(its length offsets), ``#5410``-``#5413`` (its diameter, front and back
+angle, orientation) and the predefined named parameters of LinuxCNC 2.9
+(``#<_imperial>``, ``#<_plane>``, ``#<_feed>``, ``#<_rpm>``, ``#<_ccomp>``, ...).  Their
 values are those before the reading line runs, as rs274 gives them.
 
 The stored positions and offsets are parameters a program may also write:
@@ -114,11 +115,34 @@ _READERS: dict[int | str, Callable[["MachineState"], float]] = {
     "_flood": lambda s: float(bool(s.coolant & 2)),
     "_current_tool": lambda s: float(s.tool),
     "_selected_tool": lambda s: float(s.selected_tool),
+    "_ccomp": lambda s: 410.0 if s.compensating and s.compensating_left else 420.0 if s.compensating else 400.0,
+    "_tool_offset": lambda s: float(s.tool_offset.any()),
+    "_lathe_diameter_mode": lambda s: float(s.diameter),
+    "_ijk_absolute_mode": lambda s: float(not s.arc_incremental),
+    # what rs274 run standalone gives: no task runs the machine, LinuxCNC 2.9
+    "_task": lambda s: 0.0,
+    "_vmajor": lambda s: 2.9,
+    "_vminor": lambda s: 0.0,
 }
 
 
 #: Parameters that need the machine's configuration as well as its state.
-_MACHINE_READERS: dict[int | str, Callable[["Machine"], float]] = {5401 + k: _tool_offset(k) for k in range(9)}
+def _tool_data(attribute: str, length: bool = False) -> Callable[["Machine"], float]:
+    """#5410-#5413: a datum of the tool in the spindle (a length in machine units), 0 without one."""
+    def read(m: "Machine") -> float:
+        tool = m.tools.get(m.state.tool)
+        value = float(getattr(tool, attribute)) if tool is not None else 0.0
+        return value / _machine_unit(m, 0) if length else value
+    return read
+
+
+_MACHINE_READERS: dict[int | str, Callable[["Machine"], float]] = {
+    **{5401 + k: _tool_offset(k) for k in range(9)},
+    5410: _tool_data("diameter", length=True),
+    5411: _tool_data("front_angle"),
+    5412: _tool_data("back_angle"),
+    5413: _tool_data("orientation"),
+}
 
 
 def is_state_parameter(key: int | str) -> bool:

@@ -30,7 +30,7 @@ _AXES = "XYZABC"
 
 @dataclass
 class Tool:
-    """One tool: offsets along X..C (mm, degrees), diameter (mm) and lathe orientation.
+    """One tool: offsets along X..C (mm, degrees), diameter (mm), lathe orientation and angles.
 
     ``orientation`` is the Q word, LinuxCNC's lathe tool orientation 1-9
     (where the tool tip's control point sits on the nose radius); 0 is a
@@ -43,6 +43,8 @@ class Tool:
     diameter: float = 0.0
     comment: str = ""
     orientation: int = 0
+    front_angle: float = 0.0  # I, degrees (lathe tools)
+    back_angle: float = 0.0  # J, degrees
 
 
 class ToolTable(dict):
@@ -81,7 +83,7 @@ class ToolTable(dict):
                 continue
             offset = np.array([words.get(a, 0.0) * (scale if a in "XYZ" else 1.0) for a in _AXES])
             tool = Tool(int(words["T"]), int(words.get("P", 0)), offset, words.get("D", 0.0) * scale,
-                        comment.strip(), int(words.get("Q", 0)))
+                        comment.strip(), int(words.get("Q", 0)), words.get("I", 0.0), words.get("J", 0.0))
             table[tool.number] = tool
         return table
 

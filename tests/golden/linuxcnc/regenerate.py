@@ -23,7 +23,7 @@ Usage::
 ``--rerun`` re-runs ``/usr/bin/rs274`` on every case first (the corpus
 ``.canon.csv`` files are used otherwise).  Programs in ``own/`` (ours, for
 features the corpus lacks) are always cases; ``--rerun`` refreshes their
-``.canon.csv`` too.  Writes ``manifest.tsv`` and
+``.canon.csv`` too, with the tool table ``own/NAME.tbl`` when there is one.  Writes ``manifest.tsv`` and
 ``cases/``.
 """
 
@@ -263,9 +263,12 @@ def main(argv: list[str] | None = None) -> int:
             shutil.copyfile(corpus / program, CASES / name)
             shutil.copyfile(expected, CASES / (name + ".canon.csv"))
         for program in sorted(OWN.glob("*.ngc")):
+            table = program.with_suffix(".tbl")  # a table of its own beside it, else rs274's default
             if args.rerun:
-                rerun(program, None, Path(tmp) / (program.name + ".canon"))
+                rerun(program, table if table.exists() else None, Path(tmp) / (program.name + ".canon"))
                 shutil.copyfile(Path(tmp) / (program.name + ".canon.csv"), OWN / (program.name + ".canon.csv"))
+            if table.exists():
+                shutil.copyfile(table, CASES / ("own__" + table.name))
             shutil.copyfile(program, CASES / ("own__" + program.name))
             shutil.copyfile(OWN / (program.name + ".canon.csv"), CASES / ("own__" + program.name + ".canon.csv"))
             chosen.append(f"own/{program.name}")
