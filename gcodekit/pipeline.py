@@ -72,6 +72,8 @@ class Program:
 def as_program(source: str | os.PathLike) -> Program:
     """A path names a file; a string with a newline, or no such file, is program text."""
     if isinstance(source, os.PathLike):
+        if not os.path.isfile(source):
+            raise FileNotFoundError(f"no such program file: {os.fspath(source)!r}")
         return Program(str(source), path=Path(source))
     if not isinstance(source, str):
         raise TypeError(f"expected a path or program text, not {type(source).__name__}")

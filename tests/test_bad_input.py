@@ -77,3 +77,10 @@ def test_random_bytes(data, flavor):
 @pytest.mark.parametrize("text", ["", "\n", ";", "G1", "G2 X1", "G1 X1e400", "X" * 100000, "G1 X" + "9" * 400])
 def test_edge_cases(text):
     run_both_modes(text + "\n", "rs274ngc", "linuxcnc")
+
+
+@pytest.mark.parametrize("as_path", [str, Path])
+def test_a_missing_program_file_is_named(tmp_path, as_path):
+    missing = tmp_path / "missing.ngc"
+    with pytest.raises(FileNotFoundError, match=r"no such program file: .*missing\.ngc"):
+        gcodekit.gcode_to_operation(as_path(missing), "linuxcnc")
