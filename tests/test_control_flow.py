@@ -423,3 +423,19 @@ def test_a_named_program_line_is_its_name() -> None:
     op = gcodekit.gcode_to_operation("%\nO<MyProgram> (a name)\nG0 X1\nM30\n%\n", machine="linuxcnc", plan=False)
     assert not op.diagnostics.items
     assert op.motions().iloc[-1].x == 1.0
+
+
+def test_call_level_counts_the_nested_calls():
+    # rs274 2.9: 0 in the main program, 1 in a sub it calls, 2 in a sub that one calls
+    program = """o<b> sub
+G0 X#<_call_level>
+o<b> endsub
+o<a> sub
+G0 X#<_call_level>
+o<b> call
+o<a> endsub
+G0 X#<_call_level>
+o<a> call
+G0 X#<_call_level>
+"""
+    assert texts(program) == ["G0 X0", "G0 X1", "G0 X2", "G0 X0"]

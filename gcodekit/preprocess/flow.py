@@ -18,6 +18,7 @@ to its closing ``while``, ``repeat`` to ``endrepeat``, ``sub`` to
   fresh local named parameters (``#<name>``; ``#<_name>`` is global).
   ``oN return [value]`` or ``endsub [value]`` sets ``#<_value>`` and
   ``#<_value_returned>`` = 1; both are cleared just before each call.
+  ``#<_call_level>`` is how deep the calls are nested (0 in the main program).
   Labels are numbers or ``<names>``; a call's label may be computed
   (``o[#101+2] call``).  A subroutine not in the program is read from
   ``name.ngc`` in the program's directory or the stage's ``search_path``.
@@ -233,7 +234,7 @@ class _Run:
         if os.path.isfile(file):
             self.directories.append(Path(file).resolve().parent)
         self.directories += self.stage.search_path
-        for name in ("_value", "_value_returned"):
+        for name in ("_value", "_value_returned", "_call_level"):
             if not self.store.exists(name):
                 self._set(name, 0.0)
         self.code = self._link(_Code(file, [self._statement(s) for s in lines]), main=True)
@@ -404,6 +405,7 @@ class _Run:
         start = (code, index + 1)
         self.frames.append(_Frame(self.code, self.pc, self.counters, fanuc, start, repeats - 1))
         self.code, self.pc, self.counters = code, index + 1, {}
+        self._set("_call_level", float(len(self.frames)))
 
     def _end_call(self, st: OWord) -> None:
         if not self.frames:
@@ -422,6 +424,7 @@ class _Run:
         frame = self.frames.pop()
         self.store.leave_call()
         self.code, self.pc, self.counters = frame.code, frame.pc, frame.counters
+        self._set("_call_level", float(len(self.frames)))
 
     def _find(self, label: str, table: dict[str, tuple[_Code, int]], st: OWord | SourceLine):
         """The sub (or Fanuc program) ``label``, read from a file if need be."""
