@@ -256,16 +256,18 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
                 for r in (pending, *staying):
                     if r is not None:
                         out[a][r], out[b][r] = start[0], start[1]
+            # the corner move stays at the height the tool is at: the move itself then rises or falls
+            level = {"xyz"[3 - f - g]: out["xyz"[3 - f - g]][-1]} if out["x"] else {}
             if not inside and motion == MOTION_RAPID:
                 # no rapid arc: rs274 traverses straight to where the roll would end
                 whole = float(columns["distance"][k])  # at the rapid's own speed
-                emit(k, **{a: new_start[0], b: new_start[1]}, distance=float(gap), de=0.0,
+                emit(k, **{a: new_start[0], b: new_start[1]}, **level, distance=float(gap), de=0.0,
                      time=float(columns["time"][k]) * gap / whole if whole > 0 else 0.0)
             elif not inside:  # outside corner: roll round the programmed corner
                 length = radius * _angle(start, new_start, programmed_start)
                 feed = float(columns["feed"][k])
                 emit(k, **{a: new_start[0], b: new_start[1], ca: programmed_start[0], cb: programmed_start[1]},
-                     motion=MOTION_CCW if side < 0 else MOTION_CW, distance=length, de=0.0,
+                     **level, motion=MOTION_CCW if side < 0 else MOTION_CW, distance=length, de=0.0,
                      time=length / (feed / 60.0) if feed > 0 else 0.0)
             elif pending is not None:
                 # inside corner: cut the previous move where the two offset paths meet, worked
