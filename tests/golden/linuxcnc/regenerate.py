@@ -72,6 +72,9 @@ _abs_b _abs_c _current_tool _current_pocket _selected_tool _selected_pocket
 _value _value_returned _task _call_level _remap_level
 """.split())
 
+#: Predefined parameters the control-flow stage keeps (gcodekit.preprocess.flow).
+FLOW_NAMED = frozenset({"_value", "_value_returned", "_call_level"})
+
 #: Programs gcodekit knows it does not reproduce yet, and why.
 KNOWN_GAPS: dict[str, str] = {}
 
@@ -114,7 +117,8 @@ def scan_text(text: str) -> tuple[list[str], list[str]]:
     body = re.sub(r"[ \t\r]", "", body)
     for name in NAMED.findall(body):
         key = name.lower()
-        if (key in SYSTEM_NAMED and not is_state_parameter(key)) or key.startswith(("_ini[", "_hal[")):
+        if (key in SYSTEM_NAMED and not (is_state_parameter(key) or key in FLOW_NAMED)) \
+                or key.startswith(("_ini[", "_hal[")):
             reasons[f"system parameter #<{key}>"] = None
     body = ANGLED.sub("<>", body)
     body = LETTER_RUN.sub(" ", body)
