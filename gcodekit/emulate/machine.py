@@ -207,7 +207,7 @@ class Machine:
         self.modal.cycle_mode_open = bool(n) and int(table.motion[-1]) == MOTION_CYCLE
         if cursor < n:
             self._hold(cursor, n, out)
-            self._once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
+            self.warn_once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
         return _constants_as_views(_with_extra_waypoints(out, extra, n))
 
     def _after_probe(self, start: np.ndarray) -> None:
@@ -430,7 +430,7 @@ class Machine:
         centre = end_pos[idx, :].copy()  # the helix axis keeps the end point's coordinate, then is blanked
         centre[:, f], centre[:, g] = center[:, 0], center[:, 1]
         if s.rotation and s.plane != 17:
-            self._once("tilted arc", int(t.line[rows[0]]), f"arc in G{s.plane} under an XY rotation of the work "
+            self.warn_once("tilted arc", int(t.line[rows[0]]), f"arc in G{s.plane} under an XY rotation of the work "
                        "system: its plane turns out of the machine's planes, which the centre columns cannot show")
         centre = s.to_machine(centre)
         centers[idx, f] = centre[:, f]
@@ -472,7 +472,7 @@ class Machine:
                                         else "Cannot do g1 with zero feed rate", kind="machine")
             elif bad.any():
                 first = int(np.flatnonzero(bad)[0])
-                self._once("feed", int(t.line[rows][first]), "move with no feed rate (F) in force; its time is unknown")
+                self.warn_once("feed", int(t.line[rows][first]), "move with no feed rate (F) in force; its time is unknown")
                 time[bad] = np.nan
         dwell = kind == Kind.DWELL
         if dwell.any():
@@ -486,7 +486,8 @@ class Machine:
         seconds = np.nan_to_num(s_word) if self.config.dwell_s_seconds else np.zeros(p.size)
         return np.where(~np.isnan(p), p * unit, seconds)
 
-    def _once(self, key: str, line: int, message: str) -> None:
+    def warn_once(self, key: str, line: int, message: str) -> None:
+        """A warning given the first time ``key`` comes up in the program (not on every block)."""
         if key not in self._warned:
             self._warned.add(key)
             self.diagnostics.warn(line, 1, message)

@@ -281,9 +281,9 @@ class ModalHandler:
         s = self.state
         unit = 0.001 if self.machine.config.dwell_p_unit == "ms" else 1.0
         try:
-            steps, end = run_cycle(name if name in CYCLES else "", params, s.cycle,
-                              program=s.program_position(), to_machine=s.to_machine, scale=s.scale(), plane=s.plane,
-                              incremental=s.incremental, dwell_unit=unit)
+            steps, end = run_cycle(name if name in CYCLES else "", params, s.cycle, program=s.program_position(),
+                                   to_machine=s.to_machine, scale=s.scale(), plane=s.plane,
+                                   incremental=s.incremental, dwell_unit=unit)
         except ValueError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
             return MOTION_NONE, []
@@ -294,7 +294,7 @@ class ModalHandler:
         if not steps:
             return MOTION_NONE, []
         if s.cycle.name in TAPPING and s.plane != 17:
-            self.machine._once("tapping outside G17", line, f"G74/G84 in G{s.plane}: the feeds move as LinuxCNC 2.9 "
+            self.machine.warn_once("tapping outside G17", line, f"G74/G84 in G{s.plane}: the feeds move as LinuxCNC 2.9 "
                                "sends them, with the axes mixed up (see gcodekit.emulate.cycles)")
         extra = [Waypoint({**dict(zip(AXES.lower(), st.point)), "motion": st.motion, "dwell": st.dwell})
                  for st in steps[:-1]]
@@ -590,11 +590,10 @@ class ModalHandler:
         s = self.state
         believed = s.to_machine(s.program_position())  # where rs274 thinks the machine is
         rotation = float(s.rotations[index])
-        frame = believed - s.work_offsets[index] - s.tool_offset
-        program = rotate_xy(frame, -rotation) - s.g92
+        program = rotate_xy(believed - s.work_offsets[index] - s.tool_offset, -rotation) - s.g92  # in that system
         for ax, value in values.items():
             program[ax] = value
-        s.work_offsets[index] = frame + s.work_offsets[index] - rotate_xy(program + s.g92, rotation)
+        s.work_offsets[index] = believed - s.tool_offset - rotate_xy(program + s.g92, rotation)
         if index == s.work_offset:
             s.select_work_system(index)
             s.keep_program_position(program)
