@@ -24,7 +24,7 @@ from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
-from .word_checks import MODAL_USERS, WORD_USERS, message, stray_letters
+from .word_checks import MODAL_USERS, WORD_USERS, message, stray_letters, user_code_keys
 from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CCW, MOTION_CUBIC, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
                     MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable)
 
@@ -364,7 +364,7 @@ class GcodeParser:
         for c in WORD_USERS:
             if c not in params:
                 continue
-            by_own_code = np.isin(keys, _word_user_keys(c))
+            by_own_code = np.isin(keys, user_code_keys(c))
             by_mode = implicit & np.isin(motion, [m for m, mode in modal.items() if c in MODAL_USERS[mode]])
             suspect |= ~np.isnan(params[c]) & ~by_own_code & ~by_mode
         reported = 0
@@ -404,17 +404,6 @@ def _forward_fill_modes(sets: np.ndarray, initial: int) -> np.ndarray:
     np.maximum.accumulate(idx, out=idx)
     out = np.where(idx >= 0, sets[np.maximum(idx, 0)], initial).astype(np.uint8)
     return out
-
-
-_WORD_USER_KEYS: dict[str, np.ndarray] = {}
-
-
-def _word_user_keys(word: str) -> np.ndarray:
-    """Keys (letter * 1e6 + tenths) of the codes that take ``word``."""
-    if word not in _WORD_USER_KEYS:
-        _WORD_USER_KEYS[word] = np.array(sorted(ord(code[0]) * 1_000_000 + round(float(code[1:]) * 10)
-                                                for code in WORD_USERS[word]), np.int64)
-    return _WORD_USER_KEYS[word]
 
 
 def _merge_rows(fast: dict, slow: dict) -> dict:

@@ -16,7 +16,10 @@ Examples
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable
+
+import numpy as np
 
 _LATHE = ("G70", "G71", "G71.1", "G71.2", "G72", "G72.1", "G72.2")
 _DRILLING = ("G73", "G81", "G82", "G83", "G84", "G85", "G86", "G87", "G88", "G89")
@@ -60,3 +63,10 @@ def stray_letters(letters: Iterable[str], codes: Iterable[str], modal_motion: st
 def message(letter: str) -> str:
     """rs274's complaint about a stray ``letter``."""
     return f"{letter} word with no g code that uses it (no code of the block takes {letter})"
+
+
+@functools.cache
+def user_code_keys(letter: str) -> np.ndarray:
+    """The codes that take ``letter`` as the parser keys them: letter code * 1e6 + number in tenths."""
+    return np.array(sorted(ord(code[0]) * 1_000_000 + round(float(code[1:]) * 10) for code in WORD_USERS[letter]),
+                    np.int64)
