@@ -92,3 +92,14 @@ def test_ini_values_and_subroutine_path(tmp_path):
             if d.severity == "error"] == [(1, True), (2, True)]
     with pytest.raises(gcodekit.ConfigError, match="cannot read the INI file"):
         run("G0 X1\n", ini_file=str(tmp_path / "missing.ini"))
+
+
+def test_motion_mode_is_the_motion_code_in_tenths():
+    # rs274 2.9 gives G80 (800) at the start, then 10, 20, 810, 800 and 383 here (each read before its line runs)
+    text = ("G21\nG0 X[#<_motion_mode>]\nG1 X1 F100\nG0 X[#<_motion_mode>]\nG2 X12 R1\nG0 Y[#<_motion_mode>]\n"
+            "G81 X3 Y3 Z-1 R1\nX4\nG0 X[#<_motion_mode> / 10]\nG80\nG0 Z[#<_motion_mode> / 100]\nG38.3 Z-1\n"
+            "G0 Z[#<_motion_mode> / 100]\nM2\n")
+    op = run(text)
+    assert not op.diagnostics.items
+    assert [moves(op, "x")[i] for i in (0, 2)] == [800.0, 10.0] and 20.0 in moves(op, "y")
+    assert 81.0 in moves(op, "x") and moves(op, "z")[-3] == 8.0 and moves(op, "z")[-1] == pytest.approx(3.83)

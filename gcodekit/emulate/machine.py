@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import Diagnostics
 from ..parse.commands import Kind
+from ..parse.split import MOTIONS
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, MOTION_THREAD, NAME_ID,
                            SPLINE_MOTIONS, CommandTable)
 from . import arcs
@@ -114,6 +115,7 @@ class Machine:
                                     severity="warning", file=self.tools.source)
         self.modal = ModalHandler(self)
         self._straight_ids = np.array([NAME_ID["rapid"], NAME_ID["linear"]], np.uint8)
+        self._motion_mode_ids = np.array(sorted(NAME_ID[n] for n in MOTIONS | {"rigid_tap"}), np.uint8)
         self._table_z, self._table_w = np.nan, 0.0  # last Z and table-axis words (see _part_frame)
         self._warned: set[str] = set()
         #: Where the last probe move (G38.2-G38.5) "tripped": its target in program
@@ -205,6 +207,9 @@ class Machine:
             self._run_segment(table, cursor, n, out)
             cursor = n
         self.modal.cycle_mode_open = bool(n) and int(table.motion[-1]) == MOTION_CYCLE
+        setting = np.flatnonzero((table.letter == ord("G")) & np.isin(table.name, self._motion_mode_ids))
+        if setting.size:  # the motion mode in force (#<_motion_mode>)
+            self.state.motion_code = int(table.number[setting[-1]])
         if cursor < n:
             self._hold(cursor, n, out)
             self.warn_once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")

@@ -82,6 +82,7 @@ class MachineState:
     retracted: bool = False  # firmware retraction (G10) in effect
     compensating: bool = False  # G41/G42 in force (the path is offset by a later pass)
     compensating_left: bool = False  # ... and on the left (G41, G41.1)
+    motion_code: int = 800  # the motion mode's G code in tenths (G1 10, G38.2 382): rs274 starts in G80
     cycle: CycleState = field(default_factory=CycleState)  # canned-cycle words in force
     ended: bool = False  # M2/M30 reached: later blocks are not run
 

@@ -115,6 +115,7 @@ _READERS: dict[int | str, Callable[["MachineState"], float]] = {
     "_flood": lambda s: float(bool(s.coolant & 2)),
     "_current_tool": lambda s: float(s.tool),
     "_selected_tool": lambda s: float(s.selected_tool),
+    "_motion_mode": lambda s: float(s.motion_code),
     "_ccomp": lambda s: 410.0 if s.compensating and s.compensating_left else 420.0 if s.compensating else 400.0,
     "_tool_offset": lambda s: float(s.tool_offset.any()),
     "_lathe_diameter_mode": lambda s: float(s.diameter),
