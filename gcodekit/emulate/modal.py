@@ -23,7 +23,8 @@ from .cycles import CYCLES, TAPPING, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
 from .splines import SPLINE_NAMES, SplineBlocks
-from .state import AXES, MachineState, rotate_xy
+from . import work_systems
+from .state import AXES, MachineState
 from .tooltable import Tool
 
 if TYPE_CHECKING:
@@ -174,21 +175,16 @@ class ModalHandler:
             setattr(s, attr, value)
             if attr == "incremental" and self.machine.config.distance_mode_sets_extrusion:
                 s.e_relative = value
-        elif name.startswith("work_offset_") and int(name.rsplit("_", 1)[1]) != s.work_offset:
-            believed = s.to_machine(s.program_position())  # where rs274 thinks the machine is
-            s.select_work_system(int(name.rsplit("_", 1)[1]))  # (selecting the system in force changes nothing)
-            s.keep_program_position(s.to_program(believed))
+        elif name.startswith("work_offset_"):
+            work_systems.select(s, int(name.rsplit("_", 1)[1]))
         elif name == "set_position":
-            self._set_position(params, line, t)
+            self._set_position(params, line)
         elif name == "clear_position_offset":
-            s.g92[:] = 0.0
-            s.g92_stored[:] = 0.0
-            s.g92_on = False
-        elif name == "suspend_position_offset":  # the stored offset stays for G92.3
-            s.g92[:] = 0.0
-            s.g92_on = False
+            work_systems.clear_axis_offset(s)
+        elif name == "suspend_position_offset":
+            work_systems.suspend_axis_offset(s)
         elif name == "restore_position_offset":
-            s.g92, s.g92_on = s.g92_stored.copy(), True
+            work_systems.restore_axis_offset(s)
         elif name in ("home", "home_secondary"):
             motion, extra = MOTION_RAPID, self._home(params, name == "home_secondary")
         elif name == "store_home":
@@ -236,11 +232,7 @@ class ModalHandler:
         elif name == "coordinate_data":
             self._coordinate_data(params, line)
         elif name == "local_offset":
-            scale = s.scale()
-            for ax, letter in enumerate(AXES):
-                if letter in params:  # LinuxCNC keeps G52 in the G92 offset
-                    s.g92[ax] = params[letter] * scale[ax]
-            s.g92_stored, s.g92_on = s.g92.copy(), True
+            work_systems.set_local_offset(s, self._axis_values(params))
         elif name == "set_kinematic_position":
             self._set_kinematic_position(t.command(row).text)
         elif name in ("firmware_retract", "firmware_unretract"):
@@ -261,18 +253,18 @@ class ModalHandler:
 
     # -- commands -----------------------------------------------------------------
 
-    def _set_position(self, params: dict, line: int, t: CommandTable) -> None:
-        """G92: offset the axes so the current point has the given coordinates."""
+    def _axis_values(self, params: dict) -> dict[int, float]:
+        """The block's axis words, mm (degrees for A B C), by axis index."""
+        scale = self.state.scale()
+        return {ax: params[letter] * scale[ax] for ax, letter in enumerate(AXES) if letter in params}
+
+    def _set_position(self, params: dict, line: int) -> None:
+        """G92: offset the axes so the current point has the given coordinates (and E, on printers)."""
         s = self.state
-        scale = s.scale()
-        given = [ax for ax, letter in enumerate(AXES) if letter in params]
-        if not given and "E" not in params and self.machine.config.home_mode == "stored":
+        values = self._axis_values(params)
+        if not values and "E" not in params and self.machine.config.home_mode == "stored":
             self.machine.diagnostics.report(line, 1, "G92 needs at least one axis word", kind="machine")
-        program = s.program_position()
-        for ax in given:  # the offset sits before the rotation: the given point in the unturned frame
-            s.g92[ax] = program[ax] + s.g92[ax] - params[AXES[ax]] * scale[ax]
-        if given:
-            s.g92_stored, s.g92_on = s.g92.copy(), True
+        work_systems.set_axis_offset(s, values)
         if "E" in params:
             s.e_program = params["E"] * s.units
 
@@ -538,11 +530,10 @@ class ModalHandler:
             if mode == 20 and "R" in params:
                 self.machine.diagnostics.report(line, 1, "R not allowed in G10 L20", kind="machine")
                 return
-            values = {ax: params[AXES[ax]] * scale[ax] for ax in given}
             if mode == 2:
-                self._set_work_system(index, values, params.get("R"))
+                work_systems.set_offsets(s, index, self._axis_values(params), params.get("R"))
             else:
-                self._touch_off_work_system(index, values)
+                work_systems.touch_off(s, index, self._axis_values(params))
         elif mode in (1, 10, 11):
             number = int(params.get("P", 0))
             tool = self.machine.tools.setdefault(number, Tool(number))
@@ -560,43 +551,6 @@ class ModalHandler:
                 tool.orientation = int(params["Q"])
         else:
             self.machine.diagnostics.report(line, 1, "G10 needs L1, L2, L10, L11 or L20", kind="machine")
-
-    def _set_work_system(self, index: int, values: dict[int, float], rotation: float | None) -> None:
-        """G10 L2: work system ``index`` gets offsets ``values`` (mm by axis) and maybe a new XY rotation.
-
-        In the system in force rs274 turns its idea of the current point
-        with the new rotation, leaving out the G92 offset (so the machine
-        moves on the next move when a G92 offset and a rotation change
-        meet; LinuxCNC's tests/interp coord-rotation-xy keeps that too).
-        """
-        s = self.state
-        old_offset, old_rotation = s.frame.copy(), s.frame_rotation
-        program = s.program_position()
-        for ax, value in values.items():
-            s.work_offsets[index, ax] = value
-        if rotation is not None:
-            s.rotations[index] = rotation
-        if index == s.work_offset:  # the system's stored values, all of them, come into force
-            s.select_work_system(index)
-            moved = old_offset - s.frame
-            s.keep_program_position(rotate_xy(rotate_xy(program, old_rotation) + moved, -s.rotation))
-
-    def _touch_off_work_system(self, index: int, values: dict[int, float]) -> None:
-        """G10 L20: work system ``index`` moves so the current point has coordinates ``values`` in it.
-
-        Axes without a word keep their coordinate in that system, so under a
-        rotation an X word alone moves the system's origin in X and Y.
-        """
-        s = self.state
-        believed = s.to_machine(s.program_position())  # where rs274 thinks the machine is
-        rotation = float(s.rotations[index])
-        program = rotate_xy(believed - s.work_offsets[index] - s.tool_offset, -rotation) - s.g92  # in that system
-        for ax, value in values.items():
-            program[ax] = value
-        s.work_offsets[index] = believed - s.tool_offset - rotate_xy(program + s.g92, rotation)
-        if index == s.work_offset:
-            s.select_work_system(index)
-            s.keep_program_position(program)
 
     def _home(self, params: dict, secondary: bool) -> list[Waypoint]:
         s = self.state

@@ -24,7 +24,7 @@ from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
-from .word_checks import MODAL_USERS, WORD_USERS, message, stray_letters, user_code_keys
+from .word_checks import MODAL_USERS, WORD_USERS, stray_letters, stray_word_message, user_code_keys
 from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CCW, MOTION_CUBIC, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
                     MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable)
 
@@ -375,7 +375,7 @@ class GcodeParser:
             moving = [int(motion[i]) for i in rows if implicit[i]]
             for c in stray_letters(given, codes, modal.get(moving[0]) if moving else None):
                 if reported < 100:
-                    self.diagnostics.report(int(t["line"][rows[0]]), 1, message(c))
+                    self.diagnostics.report(int(t["line"][rows[0]]), 1, stray_word_message(c))
                 reported += 1
 
     def _report_unknown(self, t: dict, name: np.ndarray) -> None:

@@ -60,7 +60,7 @@ def stray_letters(letters: Iterable[str], codes: Iterable[str], modal_motion: st
     return sorted(c for c in letters if c in WORD_USERS and c not in modal and not codes & WORD_USERS[c])
 
 
-def message(letter: str) -> str:
+def stray_word_message(letter: str) -> str:
     """rs274's complaint about a stray ``letter``."""
     return f"{letter} word with no g code that uses it (no code of the block takes {letter})"
 
