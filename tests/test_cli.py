@@ -6,8 +6,6 @@ import io
 import json
 from pathlib import Path
 
-import pytest
-
 from cli_helpers import run
 
 from gcodekit import cli
