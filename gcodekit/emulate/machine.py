@@ -435,11 +435,13 @@ class Machine:
         centre = end_pos[idx, :].copy()  # the helix axis keeps the end point's coordinate, then is blanked
         centre[:, f], centre[:, g] = center[:, 0], center[:, 1]
         if s.rotation and s.plane != 17:
-            self.warn_once("tilted arc", int(t.line[rows[0]]), f"arc in G{s.plane} under an XY rotation of the work "
-                       "system: its plane turns out of the machine's planes, which the centre columns cannot show")
+            self.warn_once("tilted arc", int(t.line[rows[0]]), f"arc in G{s.plane} under an XY rotation of the "
+                           "work system: its plane turns out of the machine's planes, which the centre columns "
+                           "cannot show")
         centre = s.to_machine(centre)
         centers[idx, f] = centre[:, f]
         centers[idx, g] = centre[:, g]
+
     def _check_radii(self, t, rows, r0, r1, units) -> None:
         # LinuxCNC 2.9 rejects centre-format arcs whose end radius differs from the start
         # radius by more than its spiral tolerance (2*sqrt(2)*0.01 mm, or 0.001 in in G20)

@@ -23,9 +23,9 @@ from .cycles import CYCLES, TAPPING, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
 from .splines import SPLINE_NAMES, SplineBlocks
-from . import work_systems
 from .state import AXES, MachineState
 from .tooltable import Tool
+from . import work_systems
 
 if TYPE_CHECKING:
     from .machine import Machine
@@ -286,8 +286,8 @@ class ModalHandler:
         if not steps:
             return MOTION_NONE, []
         if s.cycle.name in TAPPING and s.plane != 17:
-            self.machine.warn_once("tapping outside G17", line, f"G74/G84 in G{s.plane}: the feeds move as LinuxCNC 2.9 "
-                               "sends them, with the axes mixed up (see gcodekit.emulate.cycles)")
+            self.machine.warn_once("tapping outside G17", line, f"G74/G84 in G{s.plane}: the feeds move as LinuxCNC "
+                                   "2.9 sends them, with the axes mixed up (see gcodekit.emulate.cycles)")
         extra = [Waypoint({**dict(zip(AXES.lower(), st.point)), "motion": st.motion, "dwell": st.dwell})
                  for st in steps[:-1]]
         s.position = steps[-1].point.copy()
@@ -562,11 +562,7 @@ class ModalHandler:
             return []
         # rs274 goes through the given point; with no axis words through the current
         # one (a rapid of no length), then every axis goes to the stored position
-        program = s.program_position()
-        scale = s.scale()
-        for ax in given:
-            value = params[AXES[ax]] * scale[ax]
-            program[ax] = program[ax] + value if s.incremental else value
+        program = self._program_target(params, AXES)
         via = s.to_machine(program)
         # the given axes reach the stored position as program coordinates (a rotation mixes X and Y)
         s.position = s.to_machine(np.where(np.isin(np.arange(6), given), s.to_program(stored), program)) \

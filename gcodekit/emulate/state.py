@@ -27,15 +27,19 @@ def _zeros() -> np.ndarray:
 
 
 def rotate_xy(points: np.ndarray, degrees: float) -> np.ndarray:
-    """``points`` (one X Y Z A B C point, or rows of them) turned about Z by ``degrees``, counter-clockwise."""
-    points = np.array(points, float)
-    if degrees:
-        angle = np.radians(degrees)
-        cos, sin = np.cos(angle), np.sin(angle)
-        x, y = points[..., 0].copy(), points[..., 1].copy()
-        points[..., 0] = x * cos - y * sin
-        points[..., 1] = x * sin + y * cos
-    return points
+    """``points`` (one X Y Z A B C point, or rows of them) turned about Z by ``degrees``, counter-clockwise.
+
+    A new array when it turns; with no turn, ``points`` themselves.
+    """
+    points = np.asarray(points, float)
+    if not degrees:
+        return points
+    angle = np.radians(degrees)
+    cos, sin = np.cos(angle), np.sin(angle)
+    turned = points.copy()
+    turned[..., 0] = points[..., 0] * cos - points[..., 1] * sin
+    turned[..., 1] = points[..., 0] * sin + points[..., 1] * cos
+    return turned
 
 
 @dataclass
@@ -61,7 +65,7 @@ class MachineState:
     work_offsets: np.ndarray = field(default_factory=lambda: np.zeros((10, N_AXES)))
     rotations: np.ndarray = field(default_factory=lambda: np.zeros(10))
     frame: np.ndarray = field(default_factory=_zeros)  # the work offset in force
-    frame_rotation: float = 0.0  # the XY rotation in force, degrees
+    rotation: float = 0.0  # the XY rotation in force, degrees counter-clockwise
     g92: np.ndarray = field(default_factory=_zeros)  # the G92/G52 offset in force
     g92_stored: np.ndarray = field(default_factory=_zeros)  # as stored (#5211-#5219): G92.3 brings it back
     g92_on: bool = False  # #5210: set by G92, G52 and G92.3, cleared by G92.1 and G92.2
@@ -86,26 +90,21 @@ class MachineState:
     cycle: CycleState = field(default_factory=CycleState)  # canned-cycle words in force
     ended: bool = False  # M2/M30 reached: later blocks are not run
 
-    @property
-    def rotation(self) -> float:
-        """XY rotation of the work system in force, degrees counter-clockwise."""
-        return self.frame_rotation
-
     def select_work_system(self, index: int) -> None:
         """G54..G59.3 (1..9): the system's stored offsets and rotation come into force."""
         self.work_offset = index
         self.frame = self.work_offsets[index].copy()
-        self.frame_rotation = float(self.rotations[index])
+        self.rotation = float(self.rotations[index])
 
     def to_machine(self, program: np.ndarray) -> np.ndarray:
         """Program coordinates (one point or rows of points, mm) in machine coordinates."""
-        turned = rotate_xy(np.asarray(program, float) + self.g92, self.frame_rotation)
+        turned = rotate_xy(np.asarray(program, float) + self.g92, self.rotation)
         return turned + self.frame + self.tool_offset
 
     def to_program(self, machine: np.ndarray) -> np.ndarray:
         """Machine coordinates (one point or rows of points) in program coordinates, mm."""
         untool = np.asarray(machine, float) - self.frame - self.tool_offset
-        return rotate_xy(untool, -self.frame_rotation) - self.g92
+        return rotate_xy(untool, -self.rotation) - self.g92
 
     def program_position(self) -> np.ndarray:
         return self.to_program(self.position) + self.program_shift

@@ -41,7 +41,7 @@ def set_offsets(s: MachineState, index: int, values: dict[int, float], rotation:
     turns its idea of the current point with the rotation, leaving out the
     G92 offset (LinuxCNC's tests/interp coord-rotation-xy keeps that too).
     """
-    old_offset, old_rotation = s.frame.copy(), s.frame_rotation
+    old_offset, old_rotation = s.frame.copy(), s.rotation
     program = s.program_position()
     for ax, value in values.items():
         s.work_offsets[index, ax] = value
