@@ -32,7 +32,7 @@ from .memory import release_freed_memory
 from .parse import CommandTable, GcodeParser
 from .parse.table import NAME_ID
 from .read import Blocks, iter_blocks, iter_lines, read_source_lines
-from .read.percent import closing_percent_index, until_closing_percent
+from .read.percent import until_closing_percent
 from .syntax import Flavor, detect_flavor, load_flavor
 
 if TYPE_CHECKING:
@@ -267,6 +267,8 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         from .preprocess.wizards import WizardStage, needs_wizards
 
         text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
+        if flavor.percent_delimiter:  # nothing after a closing % line is read, as in rs274
+            text = b"".join(until_closing_percent(iter_lines(text))).decode("utf-8", "surrogateescape")
         # probes and reads of their results may sit in subroutine files: watch every program
         # (until a probe goes by, the watch only collects the lines)
         feedback = _MachineFeedback(flavor, diagnostics, *machine) if machine is not None else None
@@ -281,9 +283,6 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
             lines = text.split("\n")
             if lines and lines[-1] == "":
                 lines.pop()
-            closing = closing_percent_index(lines) if flavor.percent_delimiter else None
-            if closing is not None:
-                del lines[closing + 1:]  # never read, as in rs274
             source = (SourceLine(t.rstrip("\r"), k + 1, program.name) for k, t in enumerate(lines))
             if diagnostics.mode == "strict":
                 # The interpreter runs a line at a time: a line before the first

@@ -8,8 +8,8 @@ Examples
 --------
 >>> b"".join(until_closing_percent([b"%\\nG0 X1\\n", b"%\\n(notes (nested))\\n"]))
 b'%\\nG0 X1\\n%\\n'
->>> closing_percent_index(["(no opening mark)", "%", "G0 X1"]) is None
-True
+>>> b"".join(until_closing_percent([b"(no opening mark)\\n%\\nG0 X1\\n"]))
+b'(no opening mark)\\n%\\nG0 X1\\n'
 """
 
 from __future__ import annotations
@@ -21,17 +21,9 @@ _PERCENT_LINE = re.compile(rb"^[ \t]*%[ \t]*\r?$", re.MULTILINE)
 _BLANK_LINES = re.compile(rb"(?:[ \t]*\r?\n)*")
 
 
-def closing_percent_index(lines: list[str]) -> int | None:
-    """Index of the ``%`` line closing a program whose first non-blank line is ``%``, else None."""
-    marks = (k for k, text in enumerate(lines) if text.strip())
-    first = next(marks, None)
-    if first is None or lines[first].strip() != "%":
-        return None
-    return next((k for k in range(first + 1, len(lines)) if lines[k].strip() == "%"), None)
-
-
 def until_closing_percent(chunks: Iterable[bytes]) -> Iterator[bytes]:
-    """Byte chunks of whole lines, cut after the closing ``%`` line (see :func:`closing_percent_index`)."""
+    """Byte chunks of whole lines, cut after the ``%`` line that closes a program whose first
+    non-blank line is ``%``."""
     opened = None  # unknown until the first non-blank line
     rest = iter(chunks)
     for chunk in rest:
