@@ -6,7 +6,7 @@ import gzip
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from gcodekit.errors import Diagnostics, GcodeError
@@ -44,14 +44,19 @@ number = st.builds(
 )
 word = st.builds(lambda l, blank, n: l + blank + n, st.sampled_from("GMXYZEFIJKSTPgxy"),
                  st.sampled_from(["", "", " "]), number)
+# codes whose argument is the rest of the line (a file name, a message) in some flavor
+string_code = st.sampled_from(["M23", "M28", "M30", "M32", "M117", "M118", "M928", "m23", "M023", "M23.0"])
 junk = st.sampled_from(["(note)", "\"s\"", "#1", "*12", "=", "[1]", "é", "\t", "  ", "/", "%", "@"])
-line = st.lists(st.one_of(word, word, word, junk), max_size=6).map(" ".join)
+line = st.lists(st.one_of(word, word, word, junk, string_code), max_size=6).map(" ".join)
 comment = st.one_of(st.just(""), st.text(max_size=10).filter(lambda t: "\n" not in t and "\r" not in t).map(lambda t: " ;" + t))
 program = st.lists(st.builds(lambda l, c: l + c, line, comment), max_size=12).map(lambda ls: "\n".join(ls) + "\n")
 
 
 @settings(max_examples=300, deadline=None)
-@given(program, st.sampled_from(["marlin", "rs274ngc", "klipper", "grbl"]))
+@given(program, st.sampled_from(["marlin", "rs274ngc", "klipper", "grbl", "reprapfirmware"]))
+@example("M23 G0\n", "marlin")  # a file name that looks like words (found by a random draw, issue 14)
+@example("G1 M23 G0 X1 ;c\n", "klipper")
+@example("M28 G0\nM117 G1 X2\n", "reprapfirmware")
 def test_fast_scanner_matches_reference_tokenizer(text, flavor):
     fast = read_text(text, flavor=flavor)
     ref, ref_diag = reference_blocks(text, flavor)

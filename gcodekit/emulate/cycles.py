@@ -41,6 +41,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..limits import MotionBudget
 from ..parse.table import CYCLE_NAMES, MOTION_LINEAR, MOTION_RAPID
 from .arcs import PLANES
 
@@ -87,16 +88,20 @@ class CycleState:
 
 def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray,
               to_machine: Callable[[np.ndarray], np.ndarray], scale: np.ndarray, plane: int, incremental: bool,
-              dwell_unit: float) -> CycleMoves:
+              dwell_unit: float, budget: MotionBudget | None = None) -> CycleMoves:
     """Moves of one canned-cycle block (``params`` as written, in program units).
 
     The cycle works in program coordinates (mm) from ``program``, the
     current point; ``to_machine`` places each of its points on the machine.
+    ``budget``, when given, is checked against the most moves the block can
+    make before any is made (L repeats times pecks can run into billions).
 
     Raises
     ------
     ValueError
         With the interpreter's reason (no R or Z in force, Q not positive, ...).
+    TooManyMotions
+        The block would make more moves than ``budget`` has room for.
     """
     if name:
         cycle.name = name
@@ -126,6 +131,8 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
     bottom = r + cycle.z if incremental else cycle.z
     if cycle.name in ("cycle_peck", "cycle_chip_break") and not (cycle.q and cycle.q > 0):
         raise ValueError("G73/G83 need a positive Q")
+    if budget is not None:
+        budget.check(repeats * _most_moves_per_hole(cycle, r, bottom) + 1)
     clear = r if cycle.retract_to_r or old < r else old
     below_r = old < r
     steps: list[Step] = []
@@ -168,6 +175,14 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
         else:
             _drill(cycle, r, bottom, clear, go)
     return CycleMoves(steps, here)
+
+
+def _most_moves_per_hole(cycle: CycleState, r: float, bottom: float) -> float:
+    """An upper bound of the moves one hole takes: over it, to R, then the drilling (a
+    peck cycle up to three moves per peck)."""
+    if cycle.name in ("cycle_peck", "cycle_chip_break"):
+        return 3 * (max(r - bottom, 0.0) / cycle.q + 1) + 4
+    return 10
 
 
 def _back_bore_words(cycle: CycleState, params: dict, plane: int, scale: np.ndarray) -> None:

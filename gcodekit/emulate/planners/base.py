@@ -215,7 +215,21 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     is_arc = w["motion"][idx] >= 3
     if arc_segments is None or not is_arc.any():
         return PlannerMoves(start, end, speed, rows[idx], idx)
-    return _with_segmented_arcs(w, idx, is_arc, start, end, speed, rows[idx], arc_segments)
+    return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows[idx], arc_segments)
+
+
+def _chords_within_limit(op, chords: np.ndarray, rows: np.ndarray, room: int) -> np.ndarray:
+    """Chord counts of the arcs, cut down when they would pass ``max_motions`` (an arc with a huge
+    radius can ask for billions); the error names the arc asking for the most."""
+    total = float(chords.sum())
+    if total <= room:
+        return chords.astype(np.int64)
+    worst = int(np.argmax(chords))
+    op.diagnostics.report(int(op.table.line[rows[worst]]), 1, f"arcs would be cut into {total:,.0f} moves, more than "
+                          f"max_motions={op.max_motions:,}; planned with fewer chords (this one asked for "
+                          f"{chords[worst]:,.0f}), so their times are approximate", kind="limit")
+    scale = max(room, chords.size) / total
+    return np.maximum(np.floor(chords * scale), 1.0).astype(np.int64)
 
 
 def _move_ends(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -244,8 +258,9 @@ def _move_ends(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.nda
     return start, end
 
 
-def _with_segmented_arcs(w, idx, is_arc, move_start, move_end, speed, rows, arc_segments) -> PlannerMoves:
+def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc_segments) -> PlannerMoves:
     """Replace each arc waypoint by its chords (Klipper's and Marlin's plan_arc)."""
+    w = op.waypoints
     counts = np.ones(idx.size, np.int64)
     arc_idx = idx[is_arc]
     centers = np.column_stack([w["cx"], w["cy"], w["cz"]])[arc_idx]
@@ -267,7 +282,8 @@ def _with_segmented_arcs(w, idx, is_arc, move_start, move_end, speed, rows, arc_
         radius[sel] = np.hypot(*(s2 - c2).T)
     rise = end[np.arange(arc_idx.size), axes[:, 2]] - start[np.arange(arc_idx.size), axes[:, 2]]
     travel = np.hypot(radius * angle, rise)
-    counts[is_arc] = np.maximum(arc_segments(travel, angle, radius, speed[is_arc]).astype(np.int64), 1)
+    chords = np.maximum(arc_segments(travel, angle, radius, speed[is_arc]), 1.0)
+    counts[is_arc] = _chords_within_limit(op, chords, rows[is_arc], room=op.max_motions - (idx.size - arc_idx.size))
 
     total = int(counts.sum())
     owner = np.repeat(np.arange(idx.size), counts)
