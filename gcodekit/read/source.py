@@ -65,7 +65,7 @@ class _Stream:
     """A program file opened for reading: its bytes as UTF-8, and what it was."""
 
     def __init__(self, raw: IO[bytes], *, container: bool = True):
-        self.raw = raw
+        self.file = self.raw = raw
         self.archive = ""
         head = raw.peek(8)[:8] if container else b""  # type: ignore[attr-defined]
         for magic, name, opener in _ARCHIVES:
@@ -79,19 +79,23 @@ class _Stream:
     def read(self, size: int) -> bytes:
         """Up to ``size`` bytes, from one read of the container (so a damaged archive's error
         comes on the read after the last good data, which is kept)."""
-        data = self.raw.read1(size)  # type: ignore[attr-defined]
-        if not self.started:
-            self.started = True
-            if data.startswith(codecs.BOM_UTF8):
-                data = data[len(codecs.BOM_UTF8):]
-            elif data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
-                self.decoder = codecs.getincrementaldecoder("utf-16")("replace")
-        if self.decoder is not None:
-            return self.decoder.decode(data, final=not data).encode("utf-8", "surrogateescape")
-        return data
+        while True:
+            data = self.raw.read1(size)  # type: ignore[attr-defined]
+            if not self.started:
+                self.started = True
+                if data.startswith(codecs.BOM_UTF8):
+                    data = data[len(codecs.BOM_UTF8):]
+                elif data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+                    self.decoder = codecs.getincrementaldecoder("utf-16")("replace")
+            if self.decoder is None:
+                return data
+            text = self.decoder.decode(data, final=not data)
+            if text or not data:  # a read of half a character gives no text yet: read on
+                return text.encode("utf-8", "surrogateescape")
 
     def close(self) -> None:
         self.raw.close()
+        self.file.close()  # an archive reader leaves the file it was given open
 
 
 def open_program(path: str | os.PathLike) -> IO[bytes]:

@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 from .cases import make_cases
-from .runner import FAILURES, run_cases, summary
+from .runner import FAILURES, load_case, run_cases, summary
 
 
 def main() -> int:
@@ -27,7 +27,14 @@ def main() -> int:
     p.add_argument("--jobs", type=int, default=1, help="cases run at once (default: 1)")
     p.add_argument("--keep", type=Path, default=Path("fuzz-failures"), help="where failing cases are saved")
     p.add_argument("--json", type=Path, help="also write the figures here")
+    p.add_argument("--rerun", type=Path, nargs="+", metavar="FOLDER", help="run saved failing cases again")
     args = p.parse_args()
+    if args.rerun:
+        for outcome in run_cases([load_case(folder) for folder in args.rerun], timeout=args.timeout,
+                                 memory_mb=args.memory_mb):
+            print(f"{outcome.name}: {outcome.verdict}, status {outcome.status}, {outcome.seconds} s, "
+                  f"{outcome.peak_mb} MB\n{outcome.stderr}")
+        return 0
     seed = random.SystemRandom().randrange(1 << 32) if args.seed == "random" else int(args.seed)
     started = time.monotonic()
     outcomes = run_cases(make_cases(args.count, seed), timeout=args.timeout, memory_mb=args.memory_mb,

@@ -187,7 +187,16 @@ def _save(case: Case, keep: Path) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     for name, data in case.files.items():
         (folder / name).write_bytes(data)
-    (folder / "case.json").write_text(json.dumps({"args": case.args, "links": case.links}, indent=1))
+    (folder / "case.json").write_text(json.dumps({"kind": case.kind, "args": case.args, "links": case.links},
+                                                 indent=1))
+
+
+def load_case(folder: Path) -> Case:
+    """A case saved by ``keep``, to run again."""
+    meta = json.loads((folder / "case.json").read_text())
+    files = {p.name: p.read_bytes() for p in folder.iterdir() if p.name != "case.json" and not p.is_symlink()}
+    program = next(a for a in meta["args"][1:] if a in files)
+    return Case(folder.name, meta.get("kind", "saved"), program, files, meta["links"], meta["args"])
 
 
 def summary(outcomes: list[Outcome], seconds: float) -> dict:
