@@ -192,7 +192,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     if machine_config is not None:
         if not config.planner:
             raise ConfigError(f"machine {config.name!r} has no planner to read {os.fspath(machine_config)!r}")
-        from .emulate.planners import machine_options as firmware_options
+        from .plan import machine_options as firmware_options
 
         config = dataclasses.replace(config, **firmware_options(config.planner, machine_config))
     diagnostics = Diagnostics(program.name, mode)
@@ -242,7 +242,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         diagnostics.extend(machine_diagnostics)  # its warnings
         op.diagnostics = diagnostics
     if plan and config.planner:
-        from .emulate.planners import planner_settings, run_planner
+        from .plan import planner_settings, run_planner
 
         run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
     _restore_line_numbers(op.table, diagnostics)

@@ -306,7 +306,7 @@ class Operation:
             data[key] = w[key]
         data["motion"] = pd.Categorical.from_codes(w["motion"], categories=["none", *MOTION_NAMES[1:]])
         if getattr(self, "plan", None) is not None:
-            from .planners import waypoint_speeds
+            from ..plan import waypoint_speeds
 
             data.update(waypoint_speeds(self))
         data["elapsed_time"] = self.elapsed_time()
@@ -372,7 +372,7 @@ class Operation:
         frame["time"] = w["time"][moved]
         frame["t_end"] = self.elapsed_time()[moved]
         if getattr(self, "plan", None) is not None:  # planned by the machine's firmware model
-            from .planners import waypoint_speeds
+            from ..plan import waypoint_speeds
 
             for key, values in waypoint_speeds(self).items():
                 if key != "accel":

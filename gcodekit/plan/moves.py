@@ -1,4 +1,4 @@
-"""Emulate stage, planning: the moves a firmware plans, and what it planned.
+"""Plan stage: the moves a firmware plans, and what it planned.
 
 A firmware does not plan G-code lines; it plans *moves*: straight segments
 of the toolhead (arcs cut into chords by the firmware's own rule) and
@@ -18,11 +18,11 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from ...parse.table import NAME_ID
-from .. import arcs
+from ..emulate import arcs
+from ..parse.table import NAME_ID
 
 if TYPE_CHECKING:
-    from ..operation import Operation
+    from ..emulate.operation import Operation
 
 #: Chords of each arc, from its length (mm), swept angle (rad), radius (mm)
 #: and requested speed (mm/s): how many segments.
@@ -165,6 +165,22 @@ def m204_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray,
         given = ~np.isnan(value)
         out[name] = in_force(moves, rows[given], value[given], default)
     return out
+
+
+def settings_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray, letter: str,
+                      initial: float, scale: float | np.ndarray = 1.0) -> np.ndarray | float:
+    """Per move, the last value of word ``letter`` among ``rows`` before it (``initial`` before any).
+
+    ``scale`` converts the word to the planner's unit (one factor, or one
+    per row).  Returns a number when one value holds for every move (the
+    common case: the limits are set once at the top), else an array.
+    """
+    values = op.table.param(letter)[rows] * scale
+    given = ~np.isnan(values)
+    if not given.any():
+        return float(initial)
+    per_move = in_force(moves, rows[given], values[given], initial)
+    return float(per_move[0]) if per_move.min() == per_move.max() else per_move
 
 
 def happens_before(moves: PlannerMoves, rows: np.ndarray) -> np.ndarray:
