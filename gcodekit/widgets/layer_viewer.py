@@ -41,7 +41,8 @@ class ToolpathView(anywidget.AnyWidget):
     title = traitlets.Unicode("").tag(sync=True)
     radius = traitlets.Float(1.0).tag(sync=True)
     layers = traitlets.List(traitlets.Int(), default_value=[0, 0]).tag(sync=True)
-    move = traitlets.Int(0).tag(sync=True)
+    #: [top group, its last move shown], set by the kernel (and by keys pressed in the view)
+    top_move = traitlets.List(traitlets.Int(), default_value=[0, 0]).tag(sync=True)
     show_travel = traitlets.Bool(False).tag(sync=True)
     camera = traitlets.Dict().tag(sync=True)
     height = traitlets.Int(480).tag(sync=True)
@@ -113,7 +114,7 @@ class LayerViewer(PictureDisplay):
         top = path.moves_in(n_groups - 1) if path else 1
         self.moves = widgets.IntSlider(value=max(top - 1, 0), min=0, max=max(top - 1, 0), description="move",
                                        continuous_update=True, layout=widgets.Layout(width="98%"))
-        self.play = widgets.Play(value=self.moves.value, min=0, max=self.moves.max, interval=80, step=1,
+        self.play = widgets.Play(value=self.moves.value, min=0, max=self.moves.max, interval=150, step=1,
                                  description="play")
         options = choices(path) if path else [color_by]
         if color_by not in options:
@@ -132,16 +133,16 @@ class LayerViewer(PictureDisplay):
         self._send_geometry()
         self._recolor()
         widgets.jslink((self.layers, "value"), (self.view, "layers"))
-        widgets.jslink((self.moves, "value"), (self.view, "move"))
         widgets.jslink((self.play, "value"), (self.moves, "value"))
         widgets.jslink((self.travel, "value"), (self.view, "show_travel"))
-        self.view.layers, self.view.move, self.view.show_travel = list(self.layers.value), self.moves.value, show_travel
+        self.view.layers, self.view.show_travel = list(self.layers.value), show_travel
+        self.view.top_move = [self.layers.value[1], self.moves.value]
         self.layers.observe(self._on_layers, "value")
         self.moves.observe(self._on_move, "value")
         self.color_by.observe(lambda change: self._recolor(), "value")
         self.travel.observe(lambda change: setattr(self.view, "show_travel", change["new"]), "value")
         self.view.observe(self._on_camera, "camera")
-        self.view.observe(self._on_view_move, "move")
+        self.view.observe(self._on_view_move, "top_move")
         self.view.observe(self._on_view_layers, "layers")
         self._show_code()
         controls = widgets.HBox([self.color_by, self.travel, self.play])
@@ -184,15 +185,17 @@ class LayerViewer(PictureDisplay):
             self.moves.max = self.play.max = max(count - 1, 0)
             self.moves.value = self.play.value = max(count - 1, 0)
         self.view.layers = [lo, hi]
+        self.view.top_move = [hi, self.moves.value]
         self._show_code()
 
     def _on_move(self, change) -> None:
-        self.view.move = change["new"]
+        self.view.top_move = [self.layers.value[1], change["new"]]
         self._show_code()
 
     def _on_view_move(self, change) -> None:  # keys pressed in the view
-        if change["new"] != self.moves.value:
-            self.moves.value = min(max(change["new"], 0), self.moves.max)
+        group, move = change["new"]
+        if group == self.layers.value[1] and move != self.moves.value:
+            self.moves.value = min(max(move, 0), self.moves.max)
 
     def _on_view_layers(self, change) -> None:
         if tuple(change["new"]) != tuple(self.layers.value):

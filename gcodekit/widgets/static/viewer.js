@@ -90,12 +90,14 @@ function matrix(cam, radius, aspect) {
 function render({ model, el }) {
   el.classList.add("gcodekit-viewer");
   const box = document.createElement("div");
-  box.style.cssText = "position:relative;width:100%;font:12px sans-serif;user-select:none";
+  box.style.cssText = "position:relative;width:100%;min-width:0;font:12px sans-serif;user-select:none;" +
+    "border:1px solid #ddd;box-sizing:border-box";
   const canvas = document.createElement("canvas");
   canvas.tabIndex = 0;
   canvas.title = "drag: rotate · shift-drag: pan · wheel: zoom · double-click: reset · " +
     "arrows: step moves (left/right) and layers (up/down) · Home/End";
-  canvas.style.cssText = "width:100%;display:block;outline:none;background:#fff;border:1px solid #ddd";
+  // the canvas is laid over its box: its pixel size must not feed back into the page's layout
+  canvas.style.cssText = "position:absolute;inset:0;width:100%;height:100%;outline:none;background:#fff";
   const legend = document.createElement("div");
   legend.className = "gk-legend";
   legend.style.cssText = "position:absolute;top:6px;right:8px;background:rgba(255,255,255,0.85);padding:4px 6px;" +
@@ -107,7 +109,7 @@ function render({ model, el }) {
   box.append(canvas, legend, status);
   el.append(box);
 
-  const gl = canvas.getContext("webgl", { antialias: true, preserveDrawingBuffer: true });
+  const gl = canvas.getContext("webgl", { antialias: false, preserveDrawingBuffer: true });
   if (!gl) {
     status.textContent = "WebGL is not available in this browser: the picture below the controls is the last one drawn in Python.";
     return () => {};
@@ -125,7 +127,8 @@ function render({ model, el }) {
   const buffers = { pos: gl.createBuffer(), val: gl.createBuffer(), kind: gl.createBuffer() };
   const texture = gl.createTexture();
   const state = { nSeg: 0, values: new Float32Array(0), kinds: new Uint8Array(0), moveSeg: new Int32Array(1),
-    groupMove: new Int32Array(1), moveLimit: null, frame: 0, pending: false, ncat: 0 };
+    groupMove: new Int32Array(1), moveLimit: null, frame: 0, pending: false, ncat: 0, width: 400, drawn: "",
+    colors: 0 };
 
   function attribute(name, buffer, size) {
     const index = gl.getAttribLocation(program, name);
@@ -174,6 +177,7 @@ function render({ model, el }) {
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
     state.ncat = (model.get("categories") || []).length;
     state.palette = table;
+    state.colors += 1; // a new colouring: the same range must be drawn again
   }
 
   function span() {
@@ -223,20 +227,23 @@ function render({ model, el }) {
 
   function draw() {
     state.pending = false;
-    const width = Math.max(canvas.clientWidth, 50);
-    const height = model.get("height");
+    const s = span();
+    const camera = model.get("camera");
     const ratio = window.devicePixelRatio || 1;
-    canvas.style.height = height + "px";
-    if (canvas.width !== Math.round(width * ratio) || canvas.height !== Math.round(height * ratio)) {
-      canvas.width = Math.round(width * ratio);
-      canvas.height = Math.round(height * ratio);
+    // the size comes from the ResizeObserver: reading it here would force a layout of the whole page
+    const width = Math.round(Math.max(state.width, 50) * ratio), height = Math.round(model.get("height") * ratio);
+    const key = JSON.stringify([s, camera, width, height, model.get("show_travel"), state.colors]);
+    if (key === state.drawn) return; // the same picture (a control echoed back by the kernel)
+    state.drawn = key;
+    if (canvas.width !== width || canvas.height !== height) {
+      canvas.width = width;
+      canvas.height = height;
     }
     gl.viewport(0, 0, canvas.width, canvas.height);
     gl.clearColor(1, 1, 1, 1);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     gl.enable(gl.DEPTH_TEST);
     gl.depthFunc(gl.LEQUAL);
-    const s = span();
     if (!s) return;
     // the colour scale spans the work shown (the legend says what is on screen)
     let vmin = Infinity, vmax = -Infinity;
@@ -250,7 +257,7 @@ function render({ model, el }) {
       else if (Number.isFinite(x)) { if (x < vmin) vmin = x; if (x > vmax) vmax = x; }
     }
     if (!(vmin <= vmax)) { vmin = 0; vmax = 1; }
-    gl.uniformMatrix4fv(u.u_mvp, false, matrix(model.get("camera"), model.get("radius"), canvas.width / canvas.height));
+    gl.uniformMatrix4fv(u.u_mvp, false, matrix(camera, model.get("radius"), canvas.width / canvas.height));
     gl.uniform1f(u.u_vmin, vmin);
     gl.uniform1f(u.u_vmax, vmax);
     gl.uniform1f(u.u_cat, cats ? 1 : 0);
@@ -347,32 +354,44 @@ function render({ model, el }) {
       return;
     } else return;
     e.preventDefault();
-    model.set("move", move);
+    model.set("top_move", [hi, move]);
     model.save_changes();
   });
 
   const onGeometry = () => { loadGeometry(); schedule(); };
   const onColors = () => { loadColors(); schedule(); };
   const onLayers = () => { state.moveLimit = null; schedule(); };
-  const onMove = () => { state.moveLimit = model.get("move"); schedule(); };
+  // a move counts within the top group it was chosen in: one meant for another group
+  // (the kernel answering an older step) is not applied
+  const onMove = () => {
+    const [group, move] = model.get("top_move");
+    if (group === model.get("layers")[1]) { state.moveLimit = move; schedule(); }
+  };
   model.on("change:positions", onGeometry);
   model.on("change:values change:palette change:categories change:title", onColors);
   model.on("change:layers", onLayers);
-  model.on("change:move", onMove);
+  model.on("change:top_move", onMove);
   model.on("change:show_travel change:camera change:height", schedule);
-  const resize = new ResizeObserver(schedule);
-  resize.observe(canvas);
+  const resize = new ResizeObserver((entries) => {
+    const width = Math.round(entries[entries.length - 1].contentRect.width);
+    if (width !== state.width) { state.width = width; schedule(); }
+  });
+  resize.observe(box);
+  const setHeight = () => { box.style.height = model.get("height") + "px"; };
+  model.on("change:height", setHeight);
+  setHeight();
   loadGeometry();
   loadColors();
-  state.moveLimit = model.get("move");
+  onMove();
   schedule();
   return () => {
     resize.disconnect();
     model.off("change:positions", onGeometry);
     model.off("change:values change:palette change:categories change:title", onColors);
     model.off("change:layers", onLayers);
-    model.off("change:move", onMove);
+    model.off("change:top_move", onMove);
     model.off("change:show_travel change:camera change:height", schedule);
+    model.off("change:height", setHeight);
   };
 }
 
