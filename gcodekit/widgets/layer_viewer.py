@@ -221,6 +221,15 @@ class LayerViewer(PictureDisplay):
         lo, hi = self.layers.value
         return self.path.group_slice(lo, hi, self.moves.value)
 
+    def show_move(self, move: int) -> None:
+        """Move the sliders to move ``move`` (an index of ``path.move_rows``), keeping the range's lower end."""
+        if self.path is None or not 0 <= move < len(self.path.move_rows):
+            return
+        group = int(np.searchsorted(self.path.group_move, move, side="right") - 1)
+        lo = min(self.layers.value[0], group)
+        self.layers.value = (lo, group)
+        self.moves.value = move - int(self.path.group_move[group])
+
     def current_line(self) -> int | None:
         """Source line of the current move."""
         move = self.current_move
