@@ -271,12 +271,14 @@ class StageDiff(PictureDisplay):
 
             start, end, move_of = _segments(w, rows)
             rapid = motion[rows][move_of] == 1
+            # the left stage wide and pale under the right one: where both agree, both stay visible
+            width = 3.5 if index == 0 else 1.3
             for (color, style), mask, what in ((STYLES[index][0], ~rapid, "feed"), (STYLES[index][1], rapid, "rapid")):
                 segs = np.stack([start[mask][:, :2], end[mask][:, :2]], axis=1)
-                ax.add_collection(LineCollection(segs, colors=color, linestyles=style,
-                                                 linewidths=1.6 if what == "feed" else 0.9, alpha=0.85))
+                ax.add_collection(LineCollection(segs, colors=color, linestyles=style, alpha=0.45 if index == 0 else 0.9,
+                                                 linewidths=width if what == "feed" else width / 2))
                 label = f"{side.name} ({side.frame})" if what == "feed" else f"{side.name}: rapids"
-                handles.append(ax.plot([], [], color=color, linestyle=style, label=label)[0])
+                handles.append(ax.plot([], [], color=color, linestyle=style, linewidth=width, label=label)[0])
         ax.autoscale()
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(alpha=0.3)
@@ -284,6 +286,16 @@ class StageDiff(PictureDisplay):
         ax.set_ylabel("Y (mm)")
         ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=1, fontsize=8, frameon=False)
         return fig
+
+    def _repr_mimebundle_(self, include=None, exclude=None) -> dict:
+        """The live view, a PNG of the picture, and HTML with the picture and the table (read offline)."""
+        import base64
+
+        bundle = super()._repr_mimebundle_(include, exclude)
+        picture = base64.b64encode(bundle["image/png"]).decode("ascii")
+        bundle["text/html"] = f'<img src="data:image/png;base64,{picture}" alt="{html.escape(repr(self))}">' \
+                              + self.diff_html()
+        return bundle
 
     def __repr__(self) -> str:
         if self.error is not None:
