@@ -122,7 +122,8 @@ class LayerViewer(PictureDisplay):
         self.color_by = widgets.Dropdown(options=options, value=color_by, description="colour by")
         self.travel = widgets.Checkbox(value=show_travel, description="travel moves", indent=False)
         self.code = widgets.HTML(layout=widgets.Layout(width="32%", overflow="auto"))
-        self.view = ToolpathView(height=height)
+        # the canvas is laid over its box: the view takes its width from the page
+        self.view = ToolpathView(height=height, layout=widgets.Layout(width="100%"))
         self._coloring: Coloring | None = None
         if self.error is not None:
             self.message = widgets.HTML(message_html(self.error))
@@ -143,7 +144,6 @@ class LayerViewer(PictureDisplay):
         self.travel.observe(lambda change: setattr(self.view, "show_travel", change["new"]), "value")
         self.view.observe(self._on_camera, "camera")
         self.view.observe(self._on_view_move, "top_move")
-        self.view.observe(self._on_view_layers, "layers")
         self._show_code()
         controls = widgets.HBox([self.color_by, self.travel, self.play])
         self.widget = widgets.VBox([controls, self.layers, self.moves,
@@ -184,7 +184,7 @@ class LayerViewer(PictureDisplay):
         with self.moves.hold_sync(), self.play.hold_sync():
             self.moves.max = self.play.max = max(count - 1, 0)
             self.moves.value = self.play.value = max(count - 1, 0)
-        self.view.layers = [lo, hi]
+        # not view.layers: the browser links it to the slider, and an answer to an older step would undo a newer one
         self.view.top_move = [hi, self.moves.value]
         self._show_code()
 
@@ -196,10 +196,6 @@ class LayerViewer(PictureDisplay):
         group, move = change["new"]
         if group == self.layers.value[1] and move != self.moves.value:
             self.moves.value = min(max(move, 0), self.moves.max)
-
-    def _on_view_layers(self, change) -> None:
-        if tuple(change["new"]) != tuple(self.layers.value):
-            self.layers.value = tuple(change["new"])
 
     def _on_camera(self, change) -> None:
         c = change["new"] or {}

@@ -80,7 +80,7 @@ class VelocityPlot(PictureDisplay):
         self.error: str | None = None
         self.path: Toolpath | None = None
         self._linked = None
-        self.view = VelocityView(height=height, x_label=X_LABELS[x])
+        self.view = VelocityView(height=height, x_label=X_LABELS[x], layout=widgets.Layout(width="100%"))
         self.picked = widgets.HTML()
         try:
             self.path = Toolpath.of(op)
