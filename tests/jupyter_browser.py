@@ -3,7 +3,7 @@
 The server runs on a free local port with no token, its root a folder the
 caller chooses; Playwright's own browser download is not used (it cannot be
 fetched here): Debian's ``/usr/bin/chromium`` is launched instead, with
-SwiftShader for WebGL.
+SwiftShader for WebGL.  Also used by ``benchmarks/bench_widgets.py``.
 """
 
 from __future__ import annotations
@@ -19,7 +19,11 @@ import urllib.request
 from contextlib import contextmanager
 from pathlib import Path
 
-CHROMIUM_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+#: WebGL through SwiftShader (no GPU here) with the page composited in software, as Chromium does by
+#: itself on a machine without a GPU: compositing whole pages through SwiftShader cost 150-400 ms a
+#: frame here.  GCODEKIT_CHROMIUM_ARGS adds flags (for benchmarks).
+CHROMIUM_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--disable-gpu-compositing",
+                 *os.environ.get("GCODEKIT_CHROMIUM_ARGS", "").split()]
 
 
 def chromium_path() -> str | None:
