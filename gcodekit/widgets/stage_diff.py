@@ -54,12 +54,17 @@ def body(line: str) -> str:
 
 
 def align(a: list[str], b: list[str], by_source: bool) -> list[tuple[str, int | None, int | None]]:
-    """Pairs of line indices of ``a`` and ``b`` with a status: ``same``, ``changed``, ``removed`` or ``added``."""
+    """Pairs of line indices of ``a`` and ``b`` with a status: ``same``, ``changed``, ``removed`` or ``added``.
+
+    By source line, lines pair only with lines of the same source line (in
+    order); two programs pair line by line where difflib finds a replacement.
+    """
     keys_a = [source_key(x) for x in a] if by_source else [x.strip() for x in a]
     keys_b = [source_key(x) for x in b] if by_source else [x.strip() for x in b]
     rows = []
     for tag, i0, i1, j0, j1 in difflib.SequenceMatcher(None, keys_a, keys_b, autojunk=False).get_opcodes():
-        n = min(i1 - i0, j1 - j0) if tag in ("equal", "replace") else 0
+        paired = tag == "equal" or (tag == "replace" and not by_source)
+        n = min(i1 - i0, j1 - j0) if paired else 0
         for k in range(n):
             i, j = i0 + k, j0 + k
             same = body(a[i]) == body(b[j]) if by_source else tag == "equal"
@@ -198,7 +203,10 @@ class StageDiff(PictureDisplay):
             return "".join(message_html(m) for m in failed)
         source = None if self._programs is not None else self._source_lines()
         headers = (["line", "source"] if source is not None else ["#", "#"]) + [a.name, b.name]
-        out = ['<table class="gcodekit-diff" style="border-collapse:collapse;font:12px monospace;width:100%">',
+        # fixed columns: both stages stay in view however long a source line or comment is
+        widths = ["5%", "24%", "35.5%", "35.5%"] if source is not None else ["4%", "4%", "46%", "46%"]
+        out = ['<table class="gcodekit-diff" style="border-collapse:collapse;font:12px monospace;width:100%;'
+               'table-layout:fixed">', "<colgroup>" + "".join(f'<col style="width:{w}">' for w in widths) + "</colgroup>",
                "<thead><tr>" + "".join(f'<th style="text-align:left;padding:2px 6px;border-bottom:1px solid #999">'
                                         f'{html.escape(h)}</th>' for h in headers) + "</tr></thead><tbody>"]
         colors = {"same": "", "changed": "background:#fff3c4", "removed": "background:#fde0dc",
@@ -218,7 +226,8 @@ class StageDiff(PictureDisplay):
                 cells += ["" if i is None else str(i + 1), "" if j is None else str(j + 1)]
             cells += [left, right]
             out.append(f'<tr class="{status}" style="{colors[status]}">'
-                       + "".join(f'<td style="padding:1px 6px;vertical-align:top;white-space:pre">{c}</td>' for c in cells)
+                       + "".join(f'<td style="padding:1px 6px;vertical-align:top;white-space:pre;overflow:hidden;'
+                                 f'text-overflow:ellipsis">{c}</td>' for c in cells)
                        + "</tr>")
         out.append("</tbody></table>")
         note = f"{counts['changed']} changed, {counts['removed']} only left, {counts['added']} only right, " \

@@ -33,7 +33,7 @@ function render({ model, el }) {
     "padding:2px 5px;pointer-events:none;white-space:nowrap";
   const status = document.createElement("div");
   status.className = "gk-plot-status";
-  status.style.cssText = "position:absolute;right:8px;bottom:2px;color:#666";
+  status.style.cssText = "position:absolute;right:12px;top:4px;color:#666";
   box.append(canvas, tip, status);
   el.append(box);
   const ctx = canvas.getContext("2d");
