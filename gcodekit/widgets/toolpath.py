@@ -27,7 +27,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from ..additive.part import AdditivePart
     from ..emulate.operation import Operation
 
 #: How a program is stepped through: layers (additive), Z levels or source lines (mill).
