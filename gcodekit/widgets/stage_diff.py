@@ -29,7 +29,8 @@ _N_WORD = re.compile(r"^N(\d+)\s")
 _N_IN_COMMENT = re.compile(r"^\((?:dropped: )?N(\d+)\s")
 #: Codes whose effect a stage still carries in words: left out when drawing the stage "as written".
 _FRAME_CODES = re.compile(r"^N\d+\s+(G5[4-9](\.\d)?|G92(\.\d)?|G10|G43(\.\d)?|G49|G52|G4[0-2](\.\d)?)\b")
-STYLES = ((("#1f77b4", "-"), ("#1f77b4", ":")), (("#ff7f0e", "-"), ("#ff7f0e", ":")))
+#: (feed, rapid) line colour and style of the left and the right side
+STYLES = ((("#1f77b4", "-"), ("#1f77b4", "--")), (("#ff7f0e", "-"), ("#ff7f0e", "--")))
 
 
 @dataclass
@@ -255,7 +256,7 @@ class StageDiff(PictureDisplay):
         return self._ops[key]
 
     def figure(self, size: tuple[int, int] = (800, 560)):
-        """Both toolpaths from above: feed moves solid, rapids dotted, each named with its frame."""
+        """Both toolpaths from above: feed moves solid, rapids dashed, each named with its frame."""
         if self.error is not None:
             return message_figure(self.error)
         sides = self.sides()
