@@ -87,6 +87,17 @@ function matrix(cam, radius, aspect) {
   return m;
 }
 
+function softwareRenderer() {
+  // WebGL drawn on the CPU (no GPU): antialiasing there costs more than the drawing itself
+  const probe = document.createElement("canvas").getContext("webgl");
+  if (!probe) return true;
+  const info = probe.getExtension("WEBGL_debug_renderer_info");
+  const name = info ? String(probe.getParameter(info.UNMASKED_RENDERER_WEBGL)) : "";
+  const lose = probe.getExtension("WEBGL_lose_context");
+  if (lose) lose.loseContext();
+  return /swiftshader|llvmpipe|software/i.test(name);
+}
+
 function render({ model, el }) {
   el.classList.add("gcodekit-viewer");
   const box = document.createElement("div");
@@ -109,7 +120,7 @@ function render({ model, el }) {
   box.append(canvas, legend, status);
   el.append(box);
 
-  const gl = canvas.getContext("webgl", { antialias: false, preserveDrawingBuffer: true });
+  const gl = canvas.getContext("webgl", { antialias: !softwareRenderer(), preserveDrawingBuffer: true });
   if (!gl) {
     status.textContent = "WebGL is not available in this browser: the picture below the controls is the last one drawn in Python.";
     return () => {};
