@@ -88,6 +88,21 @@ def test_layer_and_move_sliders_and_colours(lab):
     assert ink(whole).sum() > 2 * ink(one).sum()  # a one-layer picture is not the whole part
     assert ink_height(whole) > 1.4 * ink_height(one)
 
+    # steps down the part are drawn from the pictures kept at checkpoints: the same as drawn afresh
+    for _ in range(3):
+        page.keyboard.press("ArrowLeft")
+    wait_status(area, "layer 0 to layer 96 · move")
+    page.wait_for_timeout(300)
+    stepped = pixels(canvas)
+    travel = area.locator("input[type=checkbox]").first
+    travel.click()
+    travel.click()  # travel shown and hidden again: everything drawn anew
+    page.wait_for_timeout(800)
+    assert np.mean(np.any(stepped != pixels(canvas), axis=2)) < 0.001
+    handles.nth(1).focus()
+    page.keyboard.press("End")
+    wait_status(area, "layer 0 to layer 99 · move")
+
     # the move slider: back to the first move of the top layer, then three steps with the keyboard
     code = area.locator(".gcodekit-code")
     last_line = int(code.get_attribute("data-line"))

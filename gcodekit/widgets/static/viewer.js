@@ -120,7 +120,9 @@ function render({ model, el }) {
   box.append(canvas, legend, status);
   el.append(box);
 
-  const gl = canvas.getContext("webgl", { antialias: !softwareRenderer(), preserveDrawingBuffer: true });
+  const software = softwareRenderer();
+  const attributes = { antialias: !software, preserveDrawingBuffer: true };
+  const gl = canvas.getContext("webgl2", attributes) || canvas.getContext("webgl", attributes);
   if (!gl) {
     status.textContent = "WebGL is not available in this browser: the picture below the controls is the last one drawn in Python.";
     return () => {};
@@ -137,9 +139,13 @@ function render({ model, el }) {
   }
   const buffers = { pos: gl.createBuffer(), val: gl.createBuffer(), kind: gl.createBuffer() };
   const texture = gl.createTexture();
+  // On a software renderer every segment costs: pictures of the range drawn so far are kept at
+  // checkpoints, so a step redraws at most one checkpoint's worth of segments plus the top layer.
+  const cache = software && typeof WebGL2RenderingContext !== "undefined" && gl instanceof WebGL2RenderingContext
+    ? { key: "", work: null, points: [], width: 0, height: 0 } : null;
   const state = { nSeg: 0, values: new Float32Array(0), kinds: new Uint8Array(0), moveSeg: new Int32Array(1),
     groupMove: new Int32Array(1), moveLimit: null, frame: 0, pending: false, ncat: 0, width: 400, drawn: "",
-    colors: 0 };
+    version: 0 };
 
   function attribute(name, buffer, size) {
     const index = gl.getAttribLocation(program, name);
@@ -166,6 +172,7 @@ function render({ model, el }) {
     gl.bufferData(gl.ARRAY_BUFFER, perVertex(state.kinds), gl.STATIC_DRAW);
     attribute("a_pos", buffers.pos, 3);
     attribute("a_kind", buffers.kind, 1);
+    state.version += 1;
   }
 
   function loadColors() {
@@ -188,7 +195,7 @@ function render({ model, el }) {
     gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
     state.ncat = (model.get("categories") || []).length;
     state.palette = table;
-    state.colors += 1; // a new colouring: the same range must be drawn again
+    state.version += 1; // a new colouring: the same range must be drawn again
   }
 
   function span() {
@@ -243,7 +250,7 @@ function render({ model, el }) {
     const ratio = window.devicePixelRatio || 1;
     // the size comes from the ResizeObserver: reading it here would force a layout of the whole page
     const width = Math.round(Math.max(state.width, 50) * ratio), height = Math.round(model.get("height") * ratio);
-    const key = JSON.stringify([s, camera, width, height, model.get("show_travel"), state.colors]);
+    const key = JSON.stringify([s, camera, width, height, model.get("show_travel"), state.version]);
     if (key === state.drawn) return; // the same picture (a control echoed back by the kernel)
     state.drawn = key;
     if (canvas.width !== width || canvas.height !== height) {
@@ -279,7 +286,12 @@ function render({ model, el }) {
     gl.uniform1i(u.u_cmap, 0);
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, texture);
-    if (s.b > s.a) gl.drawArrays(gl.LINES, 2 * s.a, 2 * (s.b - s.a));
+    if (cache) {
+      drawCached(s, JSON.stringify([s.lo, camera, canvas.width, canvas.height, model.get("show_travel"), state.version,
+        vmin, vmax]));
+    } else if (s.b > s.a) {
+      gl.drawArrays(gl.LINES, 2 * s.a, 2 * (s.b - s.a));
+    }
     if (s.current >= 0) { // the current move in red, its end as a dot
       const m0 = state.moveSeg[s.current], m1 = state.moveSeg[s.current + 1];
       gl.uniform1f(u.u_solid, 1);
@@ -295,6 +307,68 @@ function render({ model, el }) {
     status.textContent = `${groups} · move ${s.shown} of ${s.count} · ${s.b - s.a} segments`;
     status.dataset.frame = String(state.frame);
     status.dataset.segments = String(s.b - s.a);
+  }
+
+  function target(w, h) {
+    // a framebuffer with its own colour and depth: the picture up to a checkpoint, or the work picture
+    const fb = gl.createFramebuffer(), color = gl.createRenderbuffer(), depth = gl.createRenderbuffer();
+    gl.bindRenderbuffer(gl.RENDERBUFFER, color);
+    gl.renderbufferStorage(gl.RENDERBUFFER, gl.RGBA8, w, h);
+    gl.bindRenderbuffer(gl.RENDERBUFFER, depth);
+    gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, w, h);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, color);
+    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, depth);
+    return { fb, color, depth };
+  }
+
+  function release(t) {
+    if (!t) return;
+    gl.deleteFramebuffer(t.fb); gl.deleteRenderbuffer(t.color); gl.deleteRenderbuffer(t.depth);
+  }
+
+  function copy(from, to, bits) {
+    gl.bindFramebuffer(gl.READ_FRAMEBUFFER, from);
+    gl.bindFramebuffer(gl.DRAW_FRAMEBUFFER, to);
+    gl.blitFramebuffer(0, 0, cache.width, cache.height, 0, 0, cache.width, cache.height, bits, gl.NEAREST);
+  }
+
+  function drawCached(s, key) {
+    const w = canvas.width, h = canvas.height;
+    if (key !== cache.key || w !== cache.width || h !== cache.height) { // another picture: start again
+      cache.points.forEach(release);
+      release(cache.work);
+      Object.assign(cache, { key, width: w, height: h, points: [], work: target(w, h) });
+    }
+    // at most 24 checkpoints (memory: two buffers of the canvas's size each), 2000 segments apart or more
+    const step = Math.max(2000, Math.ceil(state.nSeg / 24));
+    const base = state.moveSeg[state.groupMove[s.hi]]; // where the top group starts
+    const both = gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT;
+    let j = Math.min(Math.floor((base - s.a) / step), cache.points.length) - 1;
+    while (j >= 0 && !cache.points[j]) j--;
+    let pos = s.a;
+    if (j >= 0) {
+      copy(cache.points[j].fb, cache.work.fb, both);
+      pos = s.a + (j + 1) * step;
+    } else {
+      gl.bindFramebuffer(gl.FRAMEBUFFER, cache.work.fb);
+      gl.clear(both);
+    }
+    gl.bindFramebuffer(gl.FRAMEBUFFER, cache.work.fb);
+    while (pos < base) {
+      const k = Math.floor((pos - s.a) / step);
+      const stop = Math.min(base, s.a + (k + 1) * step);
+      gl.drawArrays(gl.LINES, 2 * pos, 2 * (stop - pos));
+      if (stop === s.a + (k + 1) * step) { // a checkpoint reached: keep its picture
+        cache.points[k] = cache.points[k] || target(w, h);
+        copy(cache.work.fb, cache.points[k].fb, both);
+        gl.bindFramebuffer(gl.FRAMEBUFFER, cache.work.fb);
+      }
+      pos = stop;
+    }
+    if (s.b > base) gl.drawArrays(gl.LINES, 2 * base, 2 * (s.b - base));
+    copy(cache.work.fb, null, gl.COLOR_BUFFER_BIT);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   }
 
   function schedule() {
@@ -396,6 +470,7 @@ function render({ model, el }) {
   onMove();
   schedule();
   return () => {
+    if (cache) { cache.points.forEach(release); release(cache.work); }
     resize.disconnect();
     model.off("change:positions", onGeometry);
     model.off("change:values change:palette change:categories change:title", onColors);
