@@ -9,7 +9,8 @@ How: JupyterLab is started here and driven by Playwright in Debian's Chromium
 (SwiftShader draws WebGL on the CPU: no GPU on this machine).  A notebook
 shows ``LayerViewer(program)`` and ``VelocityPlot(program).link(viewer)``;
 the upper handle of the layer slider gets focus and the arrow key is pressed
-``--steps`` times, one press every ``--pause`` ms.  In the page, a capturing
+``--steps`` times, one press every ``--pause`` ms, then the right arrow as
+many times (steps down the part, then up).  In the page, a capturing
 ``keydown`` listener stamps the press; a ``MutationObserver`` stamps the
 view's status label, which the view rewrites right after its draw call
 (*drawn*), and the first animation frame after that (*shown*: the compositor
@@ -88,9 +89,10 @@ def browser_steps(program: Path, steps: int, pause_ms: int) -> dict:
             page.wait_for_timeout(1000)
             page.evaluate(PROBE)
             page.locator(".noUi-handle-upper").first.focus()
-            for _ in range(steps):
-                page.keyboard.press("ArrowLeft")
-                page.wait_for_timeout(pause_ms)
+            for key in ("ArrowLeft", "ArrowRight"):
+                for _ in range(steps):
+                    page.keyboard.press(key)
+                    page.wait_for_timeout(pause_ms)
             result = page.evaluate("window.gk")
             result["segments"] = int(page.get_attribute(".gk-status", "data-segments"))
             result["errors"] = list(page.console_errors)
@@ -134,7 +136,9 @@ def main(argv=None) -> int:
         for k, label in (("drawn", "key press to draw call"), ("shown", "key press to the frame shown"),
                          ("plot", "key press to VelocityPlot redrawn")):
             values = r[k]
-            print(f"  {label:36s} median {med[k]:6.0f} ms   max {max(values, default=float('nan')):6.0f} ms")
+            half = len(values) // 2
+            print(f"  {label:36s} median {med[k]:6.0f} ms   max {max(values, default=float('nan')):6.0f} ms"
+                  f"   (down {statistics.median(values[:half] or [0]):.0f}, up {statistics.median(values[half:] or [0]):.0f})")
         print(f"  peer: the step as a PNG in Python   median {statistics.median(png):6.0f} ms "
               f"(ratio {statistics.median(png) / med['shown']:.1f}x the browser's step)")
         if r["errors"]:
