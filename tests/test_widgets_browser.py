@@ -128,9 +128,27 @@ def test_layer_and_move_sliders_and_colours(lab):
     assert near(by_feature, GREEN).sum() > 500
     assert near(by_speed, GREEN).sum() < near(by_feature, GREEN).sum() / 4
 
-    # the linked plot followed the range
-    plot = page.locator(".gk-plot-status")
-    assert "every corner" not in plot.inner_text()  # the whole part: the envelope per bin
+    # the linked plot followed the range; hovering a point names its move and line, clicking one moves the viewer
+    plot_area = page.locator(".jp-OutputArea-child:has(.gcodekit-velocity)")
+    assert "every corner" not in plot_area.locator(".gk-plot-status").inner_text()  # whole part: envelope per bin
+    plot_canvas = plot_area.locator("canvas")
+    plot_canvas.hover(position={"x": 400, "y": 150})
+    tip = plot_area.locator(".gk-tip")
+    assert " · move " in tip.inner_text() and " · line " in tip.inner_text()
+    plot_canvas.click(position={"x": 400, "y": 150})
+    picked = plot_area.locator(".gcodekit-picked")
+    picked.wait_for(timeout=30_000)
+    move = int(picked.inner_text().split(",")[0].removeprefix("move "))
+    assert f"move {move}" in tip.inner_text()
+    page.wait_for_function("() => !document.querySelector('.gk-status').textContent.startsWith('layer 0 to layer 99')",
+                           timeout=30_000)  # the viewer went to that move's layer
+
+    # play steps through the moves of the top layer
+    before = area.locator(".gk-status").inner_text()
+    area.locator(".jupyter-widgets button").first.click()  # play
+    page.wait_for_function("(t) => document.querySelector('.gk-status').textContent !== t", arg=before,
+                           timeout=30_000)
+    area.locator(".jupyter-widgets button").nth(1).click()  # stop
     assert page.console_errors == []
 
 
