@@ -184,7 +184,7 @@ def _operation(source, waypoint_layer):
     if isinstance(source, str) and not source.strip():
         raise ToolpathError("the program is empty (no text)")
     try:
-        return gcode_to_operation(Path(source) if isinstance(source, str) and "\n" not in source else source), None
+        return gcode_to_operation(source), None  # a path, or the program's text
     except (GcodeError, OSError, ValueError) as exc:
         raise ToolpathError(str(exc)) from exc
 
