@@ -1,4 +1,4 @@
-"""Command line: ``gcodekit info``, ``export``, ``render``, ``translate`` and ``report``.
+"""Command line: ``gcodekit info``, ``export``, ``render``, ``translate``, ``report`` and ``notebook``.
 
 Examples
 --------
@@ -10,6 +10,7 @@ Examples
     gcodekit export print.gcode --to vtk -o print.vtp
     gcodekit render print.gcode -o print.png --color-by speed --view top
     gcodekit report *.gcode -o reports/ --workers 2
+    gcodekit notebook part.gcode -o part.ipynb
 """
 
 from __future__ import annotations
@@ -103,6 +104,17 @@ def _parser() -> argparse.ArgumentParser:
     _limits(report)
     report.add_argument("-f", "--force", action="store_true", help="overwrite existing reports in DIR")
     report.add_argument("--no-progress", action="store_true", help="never show a progress bar")
+
+    notebook = add("notebook", help="write a notebook exploring a program with the widgets")
+    notebook.add_argument("file", metavar="PROGRAM")
+    notebook.add_argument("-o", "--output", required=True, metavar="NAME.ipynb", help="notebook to write")
+    notebook.add_argument("--machine", help="machine preset (default: the one for the flavor)")
+    notebook.add_argument("--machine-config", metavar="FILE",
+                          help="the firmware's own settings for the machine's planner (Klipper printer.cfg)")
+    notebook.add_argument("--execute", action="store_true", help="run it, so it opens with its outputs")
+    notebook.add_argument("--html", action="store_true",
+                          help="also write NAME.html that shows its pictures offline (runs it)")
+    notebook.add_argument("-f", "--force", action="store_true", help="overwrite NAME.ipynb if it exists")
     return p
 
 
@@ -404,7 +416,25 @@ def _report(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
-_COMMANDS = {"info": _info, "export": _export, "render": _render, "translate": _translate, "report": _report}
+def _notebook(args: argparse.Namespace) -> int:
+    from .widgets.notebook import write_exploration_notebook
+
+    if Path(args.output).suffix != ".ipynb":
+        raise UsageError(f"{args.output}: a notebook is written to a .ipynb file")
+    if _exists(args.output, args):
+        return 2
+    if args.machine:
+        from .emulate.presets import load_machine
+
+        load_machine(args.machine)
+    write_exploration_notebook(args.file, args.output, machine=args.machine, machine_config=args.machine_config,
+                               execute=args.execute, html=args.html)
+    print(f"notebook written to {args.output}" + (" (and its .html)" if args.html else ""))
+    return 0
+
+
+_COMMANDS = {"info": _info, "export": _export, "render": _render, "translate": _translate, "report": _report,
+             "notebook": _notebook}
 
 if __name__ == "__main__":
     sys.exit(main())
