@@ -41,7 +41,7 @@ def child(path: str, machine: str) -> dict:
     """One measurement, inside a fresh interpreter."""
     t0 = time.perf_counter()
     import gcodekit
-    from gcodekit.additive.vtk import import_pyvista
+    from gcodekit.export.vtk import import_pyvista
 
     import_pyvista()  # import time is not export time
     figures = {"import_s": time.perf_counter() - t0, "import_mb": _peak_mb()}

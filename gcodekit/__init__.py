@@ -9,7 +9,7 @@ The pipeline runs text -> blocks -> commands -> machine states -> operation
 10.0
 """
 
-from .emulate.operation import (
+from .model.operation import (
     AdditiveOperation,
     AdditiveProcessData,
     Operation,
@@ -17,10 +17,11 @@ from .emulate.operation import (
     SubtractiveOperation,
     SubtractiveProcessData,
 )
-from .additive import AdditivePart, Bead, VTKExporter
+from .additive import AdditivePart, Bead
+from .export.vtk import VTKExporter
 from . import visualize
 from .analysis import export_event_series_from_gcode, gcode_dataframe_to_event_series
-from .emulate.exporters import GcodeExporter
+from .export.gcode import GcodeExporter
 from .emulate.presets import MachineConfig, list_machines, load_machine
 from .errors import (
     ConfigError,

@@ -21,7 +21,7 @@ from .parse.table import NAME_ID as NAME_ID_LOOKUP
 if TYPE_CHECKING:
     import pandas as pd
 
-    from .emulate.operation import Operation
+    from .model.operation import Operation
 
 
 def depositing(w: dict, screw: bool = False) -> np.ndarray:
@@ -74,7 +74,7 @@ def operation_statistics(op: "Operation") -> dict[str, Any]:
         if screw_extruder(op):  # pellets: no filament
             stats["filament_mm"] = stats["filament_convention"] = stats["filament_pushed_mm"] = None
         else:
-            from .additive.filament import filament_used, slicer_convention
+            from .model.filament import filament_used, slicer_convention
 
             stats["filament_mm"] = filament_used(op)
             stats["filament_convention"] = slicer_convention(op)

@@ -329,7 +329,8 @@ def _export(args: argparse.Namespace) -> int:
         events = gcode_dataframe_to_event_series(op.to_dataframe(), args.source)
         events.to_csv(target, header=False, index=False, float_format="%.6f", lineterminator="\n")
     else:
-        from .additive import AdditivePart, VTKExporter
+        from .additive import AdditivePart
+        from .export.vtk import VTKExporter
 
         if op.machine.process != "additive":
             raise UsageError(f"{args.file}: VTK export is for additive programs; machine {op.machine.name!r} "
@@ -370,7 +371,7 @@ def _translate(args: argparse.Namespace) -> int:
     op = _load(args.file, args)
     text = Transpiler(op).stage(args.stage)
     if args.to and args.to != "rs274ngc":
-        from .emulate.exporters import GcodeExporter
+        from .export.gcode import GcodeExporter
         from .pipeline import parse_program
 
         text = GcodeExporter(args.to).to_gcode(parse_program(text, flavor="rs274ngc"))

@@ -2,7 +2,7 @@
 
 No stage calls another sideways; this module chooses the flavor and the
 machine, streams the program through the stages chunk by chunk, and joins
-the chunks into one :class:`~gcodekit.emulate.operation.Operation`.
+the chunks into one :class:`~gcodekit.model.operation.Operation`.
 
 Examples
 --------
@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Callable, Iterator, Sequence
 import numpy as np
 
 from .emulate.machine import Machine
-from .emulate.operation import OPERATION_CLASSES, Operation
+from .model.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine, with_options
 from .emulate.state_parameters import is_state_parameter, is_stored_parameter, machine_parameter, set_machine_parameter
 from .errors import ConfigError, Diagnostics, GcodeError, check_choice

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
     from .additive.part import AdditivePart
-    from .emulate.operation import Operation
+    from .model.operation import Operation
 
 CAMERAS = ("iso", "top", "front", "side")
 #: Scalars with a meaning beyond a waypoint column, and the colour-bar title of each.
@@ -116,7 +116,7 @@ def _lines(pv, w: dict, xyz: np.ndarray, rows: np.ndarray) -> "pv.PolyData":
 
 def operation_polydata(op: "Operation", scalars: str = "feature") -> tuple["pv.PolyData", "pv.PolyData", list | None]:
     """The work moves (with ``scalars`` as cell data) and the travel moves of ``op`` as line meshes."""
-    from .additive.vtk import import_pyvista
+    from .export.vtk import import_pyvista
 
     pv = import_pyvista()
     w = op.waypoints
@@ -189,7 +189,7 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
     check_choice("camera", camera, CAMERAS)
     if not _is_emulated(op):
         raise ValueError(f"{op.file}: plot_operation needs an emulated operation (use gcode_to_operation)")
-    from .additive.vtk import import_pyvista
+    from .export.vtk import import_pyvista
 
     pv = import_pyvista()
     scalars = scalars or default_scalars(op)

@@ -8,7 +8,7 @@ import pytest
 
 import gcodekit
 from gcodekit import AdditivePart, Bead
-from gcodekit.additive.filament import filament_used
+from gcodekit.model.filament import filament_used
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 FILAMENT_AREA = math.pi * 1.75**2 / 4  # mm^2, the marlin preset's 1.75 mm filament

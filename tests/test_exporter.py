@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import gcodekit
-from gcodekit.emulate.exporters import GcodeExporter, GcodeExportError, format_number
+from gcodekit.export.gcode import GcodeExporter, GcodeExportError, format_number
 from gcodekit.errors import ConfigError
 from gcodekit.parse.commands import Comment, Config, M, Move, MoveExtrude
 

@@ -1,13 +1,12 @@
-"""Output stage for deposition processes: filament use, beads and parts.
+"""Output stage for deposition processes: beads and parts.
 
-:class:`Bead` is the cross-section laid down, :class:`AdditivePart` groups an
-additive operation's waypoints into deposition and travel segments and
-layers, and :class:`VTKExporter` writes a part for ParaView.
+:class:`Bead` is the cross-section laid down and :class:`AdditivePart` groups
+an additive operation's waypoints into deposition and travel segments and
+layers; :class:`~gcodekit.export.vtk.VTKExporter` writes a part for ParaView
+and :func:`~gcodekit.model.filament.filament_used` counts its filament.
 """
 
 from .bead import Bead, bead_area
-from .filament import filament_used
 from .part import AdditivePart
-from .vtk import VTKExporter
 
-__all__ = ["AdditivePart", "Bead", "VTKExporter", "bead_area", "filament_used"]
+__all__ = ["AdditivePart", "Bead", "bead_area"]

@@ -37,7 +37,7 @@ from .bead import Bead
 if TYPE_CHECKING:
     import pandas as pd
 
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 
 def concatenated_ranges(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:

@@ -1,18 +1,6 @@
-"""Emulate stage: the modal machine, its presets, and the Operation it produces."""
+"""Emulate stage: the modal machine and its presets (the Operation it feeds is in :mod:`gcodekit.model`)."""
 
-from .machine import FLOAT_COLUMNS, SMALL_COLUMNS, Machine
-from .operation import (
-    AdditiveOperation,
-    AdditiveProcessData,
-    Operation,
-    ProcessData,
-    SubtractiveOperation,
-    SubtractiveProcessData,
-)
+from .machine import Machine
 from .presets import MachineConfig, list_machines, load_machine
 
-__all__ = [
-    "FLOAT_COLUMNS", "SMALL_COLUMNS", "Machine", "AdditiveOperation", "AdditiveProcessData", "Operation",
-    "ProcessData", "SubtractiveOperation", "SubtractiveProcessData", "MachineConfig", "list_machines",
-    "load_machine",
-]
+__all__ = ["Machine", "MachineConfig", "list_machines", "load_machine"]

@@ -51,7 +51,7 @@ from ..parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, MOTION_RAPID, NA
 from .arcs import PLANES, single_turn_lengths
 
 if TYPE_CHECKING:
-    from .operation import Operation
+    from ..model.operation import Operation
 
 _SIDES = {NAME_ID["cutter_comp_left"]: 1, NAME_ID["cutter_comp_right"]: -1, NAME_ID["cutter_comp_off"]: 0,
           NAME_ID["cutter_comp_left_dynamic"]: 1, NAME_ID["cutter_comp_right_dynamic"]: -1}

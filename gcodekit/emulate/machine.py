@@ -24,6 +24,7 @@ from ..parse.commands import Kind
 from ..parse.split import MOTIONS
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, MOTION_THREAD, NAME_ID,
                            SPLINE_MOTIONS, CommandTable)
+from ..schema import allocate
 from . import arcs
 from .ini import LinuxCncIni
 from .modal import ModalHandler, Waypoint
@@ -31,26 +32,6 @@ from .presets import MachineConfig
 from .state import AXES, MachineState
 from .tooltable import ToolTable
 
-#: Float columns of the waypoint table, with their meaning and unit.
-FLOAT_COLUMNS = {
-    "x": "X, machine coordinates, mm", "y": "Y, mm", "z": "Z, mm",
-    "a": "A, degrees", "b": "B, degrees", "c": "C, degrees",
-    "de": "filament pushed by this step, mm", "feed": "feed rate in force, mm/min",
-    "distance": "path length of this step, mm", "time": "duration of this step, s",
-    "cx": "arc centre X, mm (NaN if not an arc or the helix axis)", "cy": "arc centre Y, mm",
-    "cz": "arc centre Z, mm", "spindle": "spindle speed, rpm (negative: counter-clockwise)",
-}
-SMALL_COLUMNS = {
-    "motion": (np.uint8, "0 none, 1 rapid, 2 feed, 3 arc_cw, 4 arc_ccw"),
-    "plane": (np.uint8, "17, 18 or 19"),
-    "units": (np.uint8, "program units in force: 0 mm, 1 inch"),
-    "tool": (np.int32, "tool in the spindle or active extruder"),
-    "coolant": (np.uint8, "bit 1 mist, bit 2 flood"),
-    "laser": (np.uint8, "1 while the laser/weld heat source is on (DED: M61 on, M62 off)"),
-    "work_offset": (np.uint8, "1..9 for G54..G59.3"),
-    "flow": (np.float32, "extrusion multiplier in force (M221), ratio: de is the programmed E times it"),
-    "rotation": (np.float64, "XY rotation of the work system in force (G10 L2 R), degrees counter-clockwise"),
-}
 _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTRUDE, Kind.MOVE_MILL,
                            Kind.ARC_MILL, Kind.EXTRUDE}), np.uint8)
 _MILL = np.array([Kind.MILL, Kind.MOVE_MILL, Kind.ARC_MILL], np.uint8)
@@ -176,16 +157,15 @@ class Machine:
     def run(self, table: CommandTable) -> dict[str, np.ndarray]:
         """Waypoint columns for ``table``: one per command plus any extra ones.
 
-        The returned dict holds the :data:`FLOAT_COLUMNS` and
-        :data:`SMALL_COLUMNS` arrays and ``command`` (row of the command each
+        The returned dict holds the arrays of
+        :data:`gcodekit.schema.WAYPOINT_COLUMNS` and ``command`` (row of the command each
         waypoint belongs to) when some command added waypoints.
         """
         table = self._part_frame(self._radius_words(table))
         n = len(table)
         stop = 0 if self.out_of_budget else min(n, self.budget.room)  # each block makes a waypoint
         self.budget.spend(stop)
-        out = {k: np.empty(n) for k in FLOAT_COLUMNS}
-        out.update({k: np.empty(n, dtype) for k, (dtype, _) in SMALL_COLUMNS.items()})
+        out = allocate(n)
         special = np.isin(table.name, self.modal.special_ids) | (table.letter == ord("T"))
         special |= table.kind == Kind.MACHINE_COORDINATES
         special |= np.isin(table.motion, (MOTION_CYCLE, MOTION_THREAD) + SPLINE_MOTIONS) & np.isin(table.kind, _MOVING)

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_RAPID,
                            MOTION_THREAD, NAME_ID, NAMES, SPLINE_MOTIONS, CommandTable)
+from ..parse.calls import call_bead_area
 from ..parse.commands import Kind
 from .arcs import PLANES, centres, reach_tolerance, single_turn_lengths
 from .cycles import CYCLES, TAPPING, polar_target, run_cycle
@@ -57,21 +58,6 @@ _SIMPLE = {
     "polar_on": ("polar", True), "polar_off": ("polar", False),
     "diameter_mode": ("diameter", True), "radius_mode": ("diameter", False),
 }
-
-
-def bead_area(arguments: str) -> float:
-    """Width x height (mm^2) from a bead call's argument text ``"8,2,1400"``; NaN if unreadable.
-
-    Examples
-    --------
-    >>> bead_area("8.0000,2.0000,1400"), bead_area("0,0,1")
-    (16.0, 0.0)
-    """
-    values = arguments.strip("() ").split(",")
-    try:
-        return float(values[0]) * float(values[1])
-    except (IndexError, ValueError):
-        return float("nan")
 
 
 @dataclass
@@ -210,7 +196,7 @@ class ModalHandler:
         elif name == "deposition_switch":  # CEAD's "EM=1" / "EM=0": material on or off from here
             s.laser = int(params.get("value", 1.0) != 0.0)
         elif name == "set_bead":  # CEAD's EXTRUDERSPEED2(w, h, ..): a zero bead is the screw at 0 rpm
-            area = bead_area(t.named.get(row, ("", ""))[1])
+            area = call_bead_area(t.named.get(row, ("", ""))[1])
             if area == 0.0:
                 s.laser = 0
         elif name in ("coolant_mist", "coolant_flood", "coolant_off"):

@@ -19,7 +19,6 @@ from .cycles import CycleState
 N_AXES = 6  # X Y Z A B C
 AXES = "XYZABC"
 LINEAR = np.array([True, True, True, False, False, False])
-MM_PER_INCH = 25.4
 
 
 def _zeros() -> np.ndarray:

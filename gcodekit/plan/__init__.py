@@ -20,7 +20,7 @@ from ..errors import ConfigError, did_you_mean
 from .moves import PlannedMoves, PlannerMoves, PlanResult
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 #: Planner name -> (module, settings class, reader of the firmware's own config file)
 PLANNERS = {

@@ -33,7 +33,7 @@ from .lookahead import empty_result, limit_by_axis_maximum, lookahead, trapezoid
 from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 MINIMUM_FEED_RATE = 1.0 / 60.0  # grbl config.h: MINIMUM_FEED_RATE 1.0 mm/min
 MINIMUM_JUNCTION_SPEED = 0.0  # grbl config.h, mm/s

@@ -27,7 +27,7 @@ from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmwar
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 EXTRUDE_ONLY_ACCEL = 99999999.9  # klippy: "self.accel = 99999999.9" for extrude-only moves
 NO_LIMIT_V2 = 999999999.9  # klippy's next_junction_v2 default

@@ -43,7 +43,7 @@ from .moves import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmwa
                     m204_in_force, settings_in_force, speed_factor)
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 COS_REVERSAL = 0.999999  # planner.cpp: a junction_cos_theta above this is a full reversal
 COS_OCTAGON = -0.7071067812  # JD_HANDLE_SMALL_SEGMENTS: junctions sharper than 135 degrees

@@ -33,7 +33,7 @@ from .profile import BAAMMotionProfile, MotionProfile
 from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 #: Commands before which the machine has come to rest.
 STOP_NAMES = (

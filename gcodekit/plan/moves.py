@@ -22,7 +22,7 @@ from ..emulate import arcs
 from ..parse.table import NAME_ID
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 #: Chords of each arc, from its length (mm), swept angle (rad), radius (mm)
 #: and requested speed (mm/s): how many segments.

@@ -39,7 +39,7 @@ from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, happ
 
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 AXES = "XYZE"
 #: Commands RRF runs only once the moves before them are done (LockMovementAndWaitForStandstill).

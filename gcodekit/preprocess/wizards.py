@@ -70,6 +70,7 @@ from gcodekit.errors import (
     did_you_mean,
 )
 from gcodekit.limits import MAX_MOTIONS
+from gcodekit.units import MM_PER_INCH
 
 if TYPE_CHECKING:
     from gcodekit.preprocess import SourceLine
@@ -85,7 +86,6 @@ DEFAULT_SETTINGS: Mapping[str, float] = {
     "safe_z": 5.0,
     "stepover": 0.4,  # fraction of the tool diameter
 }
-MM_PER_INCH = 25.4
 # Most passes, rows or rings one built-in plans; beyond that the arguments
 # are nonsense (a 1e-9 stepdown), not a program.
 _MAX_STEPS = MAX_LINES

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 #: Diagnostics listed on a page; the rest are counted (a broken program can have thousands).
 MAX_DIAGNOSTICS = 200

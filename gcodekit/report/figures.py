@@ -22,7 +22,7 @@ from ..emulate.arcs import PLANES, sweep
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 #: Segments drawn in the 3D view and the top view (beyond this they only add ink).
 MAX_3D_SEGMENTS = 25_000

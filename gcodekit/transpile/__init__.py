@@ -43,7 +43,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..emulate.arcs import PLANES
-from ..emulate.exporters import format_number
+from ..export.gcode import format_number
 from ..emulate.lathe import profile_of, program_comment
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
@@ -81,7 +81,7 @@ class Transpiler:
 
     def __init__(self, source, machine: str | None = None, *, flavor: str | None = None, precision: int = 4,
                  **options):
-        from ..emulate.operation import Operation
+        from ..model.operation import Operation
         from ..pipeline import gcode_to_operation
 
         if isinstance(source, Operation):

@@ -24,7 +24,7 @@ import re
 import numpy as np
 
 from ..emulate.arcs import PLANES
-from ..emulate.exporters import format_number
+from ..export.gcode import format_number
 from ..parse.table import LATHE_CYCLE_NAMES
 
 #: Words that are lengths, unless the command has its own set below

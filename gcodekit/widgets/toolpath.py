@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
 
 #: How a program is stepped through: layers (additive), Z levels or source lines (mill).
 GROUP_BY = ("layer", "z", "line")
@@ -168,7 +168,7 @@ class Toolpath:
 
 def _operation(source, waypoint_layer):
     """The emulated operation of ``source`` and its waypoint layers (None: derive)."""
-    from ..emulate.operation import Operation
+    from ..model.operation import Operation
     from ..errors import GcodeError
 
     if hasattr(source, "operation") and hasattr(source, "waypoint_layer"):  # an AdditivePart

@@ -1,4 +1,4 @@
-"""Output stage: the filament a program uses, counted the way its slicer counts it.
+"""Model: the filament a program uses, counted the way its slicer counts it.
 
 A print's filament can be counted three ways, and slicers disagree:
 
@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from ..emulate.operation import Operation
+    from .operation import Operation
 
 CONVENTIONS = ("net", "consumed", "positive")
 #: Header comments naming the slicer, and how that slicer counts filament.

@@ -16,7 +16,7 @@ from ..errors import ConfigError, MissingDependencyError
 if TYPE_CHECKING:
     import pyvista as pv
 
-    from .part import AdditivePart
+    from ..additive.part import AdditivePart
 
 
 def import_pyvista():

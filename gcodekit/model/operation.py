@@ -1,4 +1,4 @@
-"""Emulate stage output: Operation, the commands paired with their process data.
+"""Model: Operation, a program's commands paired with their process data.
 
 An Operation holds the parsed commands (a :class:`CommandTable`) and, once a
 machine has run them, a table of waypoints: one per command (its end
@@ -25,17 +25,18 @@ import numpy as np
 
 from ..errors import Diagnostics
 from ..limits import MAX_MOTIONS
+from ..parse.calls import call_bead_area
 from ..parse.commands import Command, Kind
 from ..parse.table import MOTION_NAMES, NAME_ID, CommandTable
 from ..syntax.flavor import code_label
-from .machine import FLOAT_COLUMNS, SMALL_COLUMNS
-from .state import MM_PER_INCH
+from ..schema import WAYPOINT_COLUMNS
+from ..units import MM_PER_INCH
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from ..syntax import Flavor
-    from .presets import MachineConfig
+    from ..emulate.presets import MachineConfig
 
 
 @dataclass(frozen=True)
@@ -284,7 +285,7 @@ class Operation:
         """One row per waypoint: command columns then process columns.
 
         Columns: ``line``, ``command`` (row in ``commands``), ``code``,
-        ``kind``, then the waypoint columns (see :data:`COLUMN_DOC`) and
+        ``kind``, then the waypoint columns (see :data:`gcodekit.schema.WAYPOINT_COLUMNS`) and
         ``elapsed_time``.  Before emulation, one row per command with only
         the command columns and the parameters.
         """
@@ -300,10 +301,8 @@ class Operation:
         cmd = w.get("command")
         rows = np.arange(len(t)) if cmd is None else cmd
         data = {"line": t.line[rows], "command": rows, "code": self._codes()[rows], "kind": self._kinds()[rows]}
-        for key in FLOAT_COLUMNS:
-            data[key] = w[key]
-        for key in SMALL_COLUMNS:
-            data[key] = w[key]
+        for column in WAYPOINT_COLUMNS:
+            data[column.name] = w[column.name]
         data["motion"] = pd.Categorical.from_codes(w["motion"], categories=["none", *MOTION_NAMES[1:]])
         if getattr(self, "plan", None) is not None:
             from ..plan import waypoint_speeds
@@ -436,8 +435,6 @@ class AdditiveOperation(Operation):
         >>> op.bead_areas().tolist()[-2:]
         [16.0, 16.0]
         """
-        from .modal import bead_area
-
         w = self.waypoints
         rows = np.asarray(w["command"]) if "command" in w else np.arange(len(w["x"]))
         n = len(self.table)
@@ -445,7 +442,7 @@ class AdditiveOperation(Operation):
         area_of_row = np.full(n, np.nan)
         set_at = np.full(n, -1)
         for row in calls.tolist():
-            area_of_row[row] = bead_area(self.table.named.get(row, ("", ""))[1])
+            area_of_row[row] = call_bead_area(self.table.named.get(row, ("", ""))[1])
             set_at[row] = row
         np.maximum.accumulate(set_at, out=set_at)  # the last call at or before each row
         area = np.where(set_at >= 0, area_of_row[np.maximum(set_at, 0)], np.nan)

@@ -1,10 +1,10 @@
-"""Emulate stage output: exact axis-aligned bounds of a toolpath, arcs included."""
+"""Model: exact axis-aligned bounds of a toolpath, arcs included."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from . import arcs
+from ..emulate import arcs
 
 _SELECT = {
     "motion": lambda w: w["motion"] > 0,

@@ -1,7 +1,7 @@
-"""Emulate stage output: write commands back as G-code text or as table rows.
+"""Output: write commands back as G-code text or as table rows.
 
 :class:`GcodeExporter` turns parsed :class:`~gcodekit.parse.commands.Command`
-objects (a list, or an :class:`~gcodekit.emulate.operation.Operation`) into
+objects (a list, or an :class:`~gcodekit.model.operation.Operation`) into
 the text of a target flavor, or into flat dict/DataFrame rows.  It uses the
 same flavor files as the parser, so parsing what it writes gives back the
 same commands (code, name, parameters to the printed precision, comments),
@@ -51,7 +51,7 @@ from ..syntax import Flavor, load_flavor
 if TYPE_CHECKING:
     import pandas as pd
 
-    from .operation import Operation
+    from ..model.operation import Operation
 
 __all__ = ["GcodeExporter", "GcodeExportError", "format_number"]
 

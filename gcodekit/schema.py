@@ -1,0 +1,81 @@
+"""The waypoint table's columns: name, unit, dtype and meaning, in one place.
+
+After emulation the truth about a program is a table of waypoints: one row
+per command (its end state) plus the points commands pass through.  The
+machine fills the :data:`WAYPOINT_COLUMNS`; the planner and the operation
+add the :data:`DERIVED_COLUMNS`.  ``Operation.columns`` and the DataFrames
+show the same schema, so a user can look up what a column is and in what
+unit.
+
+Examples
+--------
+>>> COLUMNS["feed"].unit, COLUMNS["layer"].dtype
+('mm/min', 'int32')
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Column", "WAYPOINT_COLUMNS", "DERIVED_COLUMNS", "COLUMNS", "allocate"]
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column of the waypoint table."""
+
+    name: str
+    unit: str  # "" when the column has no unit (codes, counts)
+    dtype: str
+    meaning: str
+
+
+#: Columns the machine writes for every waypoint (machine coordinates, all offsets applied).
+WAYPOINT_COLUMNS: tuple[Column, ...] = (
+    Column("x", "mm", "float64", "X, machine coordinates"),
+    Column("y", "mm", "float64", "Y, machine coordinates"),
+    Column("z", "mm", "float64", "Z, machine coordinates"),
+    Column("a", "deg", "float64", "A, machine coordinates"),
+    Column("b", "deg", "float64", "B, machine coordinates"),
+    Column("c", "deg", "float64", "C, machine coordinates"),
+    Column("de", "mm", "float64", "filament (or wire, or screw travel) pushed by this step"),
+    Column("feed", "mm/min", "float64", "feed rate in force"),
+    Column("distance", "mm", "float64", "path length of this step"),
+    Column("time", "s", "float64", "duration of this step (planned, when the machine has a planner)"),
+    Column("cx", "mm", "float64", "arc centre X (NaN unless an arc; NaN on the helix axis)"),
+    Column("cy", "mm", "float64", "arc centre Y"),
+    Column("cz", "mm", "float64", "arc centre Z"),
+    Column("spindle", "rpm", "float64", "spindle speed, negative when counter-clockwise"),
+    Column("motion", "", "uint8", "0 none, 1 rapid, 2 feed, 3 arc clockwise, 4 arc counter-clockwise"),
+    Column("plane", "", "uint8", "arc plane in force: 17 XY, 18 XZ, 19 YZ"),
+    Column("units", "", "uint8", "program units in force: 0 mm, 1 inch"),
+    Column("tool", "", "int32", "tool in the spindle, or the active extruder"),
+    Column("coolant", "", "uint8", "bit 1 mist, bit 2 flood"),
+    Column("laser", "", "uint8", "1 while the laser or weld heat source is on (DED: M61 on, M62 off)"),
+    Column("work_offset", "", "uint8", "work system in force: 1..9 for G54..G59.3"),
+    Column("flow", "ratio", "float32", "extrusion multiplier in force (M221): de is the programmed E times it"),
+    Column("rotation", "deg", "float64", "XY rotation of the work system in force (G10 L2 R), counter-clockwise"),
+)
+
+#: Columns derived once from the waypoints and kept on the operation, or added by the planner.
+DERIVED_COLUMNS: tuple[Column, ...] = (
+    Column("layer", "", "int32", "layer of the waypoint, 0 first (-1 before the first); one definition, "
+                                 "see gcodekit.model.derived"),
+    Column("feature", "", "object", "slicer feature (;TYPE: comment) or DED fraction in force; '' when none"),
+    Column("depositing", "", "bool", "the step lays material"),
+    Column("elapsed_time", "s", "float64", "time from the program's start to the end of the step"),
+    Column("start_time", "s", "float64", "time from the program's start to the start of the step"),
+    Column("start_v", "mm/s", "float64", "planned speed entering the step (first firmware move)"),
+    Column("cruise_v", "mm/s", "float64", "fastest planned cruise speed of the step"),
+    Column("end_v", "mm/s", "float64", "planned speed leaving the step (last firmware move)"),
+    Column("accel", "mm/s^2", "float64", "acceleration the planner used for the step's first move"),
+)
+
+COLUMNS: dict[str, Column] = {c.name: c for c in WAYPOINT_COLUMNS + DERIVED_COLUMNS}
+
+
+def allocate(n: int) -> dict[str, np.ndarray]:
+    """Empty arrays for ``n`` waypoints, one per :data:`WAYPOINT_COLUMNS` entry, in order."""
+    return {c.name: np.empty(n, c.dtype) for c in WAYPOINT_COLUMNS}
