@@ -417,6 +417,11 @@ class Machine:
         o1 = _take(t, l1, rows) * s.units
         o2 = _take(t, l2, rows) * s.units
         clockwise = t.motion[rows] == MOTION_CW
+        if self.rs274_blocks and "IJK"[h] in t.params:  # rs274 refuses the centre word of the plane's normal axis
+            normal = ~np.isnan(_take(t, "IJK"[h], rows))
+            for i in np.flatnonzero(normal)[:20]:
+                self.diagnostics.report(int(t.line[rows[i]]), 1, f"{'IJK'[h]} word given for arc in "
+                                        f"{arcs.PLANE_NAMES[s.plane]} plane", kind="machine")
         no_center = np.isnan(r_word) & np.isnan(o1) & np.isnan(o2)
         for i in np.flatnonzero(no_center)[:20]:
             self.diagnostics.report(int(t.line[rows[i]]), 1, f"arc needs {l1}/{l2} offsets or R in this plane (G{s.plane})",

@@ -139,10 +139,12 @@ class ModalHandler:
             self._cycle_name = "cycle_thread"
             motion, extra = self._threading_cycle(params, line)
         elif moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
-            self._cycle_name = name or self._cycle_name
-            if not (int(t.motion[row - 1]) == MOTION_CYCLE if row else self.cycle_mode_open):
+            in_mode = int(t.motion[row - 1]) == MOTION_CYCLE if row else self.cycle_mode_open
+            if not in_mode:
                 s.cycle.initial = None  # the cycle mode begins here
-            motion, extra = self._cycle(name, params, line)
+            same_mode = in_mode and name in ("", self._cycle_name)  # rs274: motion_mode == motion
+            self._cycle_name = name or self._cycle_name
+            motion, extra = self._cycle(name, params, line, same_mode)
         elif moves and int(t.motion[row]) == MOTION_THREAD:
             rigid = name == "rigid_tap" or (not name and self._thread_name == "rigid_tap")
             self._thread_name = "rigid_tap" if rigid else "thread"
@@ -173,6 +175,8 @@ class ModalHandler:
             if attr == "units" and keep_feed:
                 s.feed *= value / s.units  # the same F number in the new units
             setattr(s, attr, value)
+            if attr == "feed_mode" and self.machine.rs274_blocks and "F" not in params:
+                s.feed = 0.0  # rs274 2.9: G93, G94 and G95 zero the feed rate (an F in the block is set after)
             if attr == "incremental" and self.machine.config.distance_mode_sets_extrusion:
                 s.e_relative = value
         elif name.startswith("work_offset_"):
@@ -224,9 +228,10 @@ class ModalHandler:
             # M6 block keeps the program position; elsewhere the machine stays.
             s.change_tool_offset(offset if name == "tool_length_offset" else s.tool_offset + offset,
                                  keep_program_position=line == self._tool_change_line)
-        elif name == "tool_length_offset_dynamic":
+        elif name == "tool_length_offset_dynamic":  # G43.1: the axes it names; the others keep their offsets
             scale = s.scale()
-            s.change_tool_offset([params.get(letter, 0.0) * scale[ax] for ax, letter in enumerate(AXES)])
+            s.change_tool_offset([params[letter] * scale[ax] if letter in params else s.tool_offset[ax]
+                                  for ax, letter in enumerate(AXES)])
         elif name == "cancel_tool_length":
             s.change_tool_offset(np.zeros(6))
         elif name == "coordinate_data":
@@ -268,20 +273,19 @@ class ModalHandler:
         if "E" in params:
             s.e_program = params["E"] * s.units
 
-    def _cycle(self, name: str, params: dict, line: int) -> tuple[int, list[Waypoint]]:
+    def _cycle(self, name: str, params: dict, line: int, same_mode: bool = True) -> tuple[int, list[Waypoint]]:
         """A canned-cycle block: its moves become waypoints (see :mod:`.cycles`)."""
         s = self.state
         unit = 0.001 if self.machine.config.dwell_p_unit == "ms" else 1.0
         try:
+            if self.machine.rs274_blocks:
+                self._check_cycle_conditions(name or self._cycle_name)
             steps, end = run_cycle(name if name in CYCLES else "", params, s.cycle, program=s.program_position(),
                                    to_machine=s.to_machine, scale=s.scale(), plane=s.plane,
-                                   incremental=s.incremental, dwell_unit=unit)
+                                   incremental=s.incremental, dwell_unit=unit,
+                                   same_mode=same_mode or not self.machine.rs274_blocks)
         except ValueError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
-            return MOTION_NONE, []
-        code = _SPINDLE_CYCLES.get(name or self._cycle_name)
-        if code and s.spindle == 0 and self.machine.rs274_blocks:
-            self.machine.diagnostics.report(line, 1, f"Spindle not turning in {code}", kind="machine")
             return MOTION_NONE, []
         if not steps:
             return MOTION_NONE, []
@@ -294,6 +298,23 @@ class ModalHandler:
         self._believed = end  # where rs274 takes the tool to be (see cycles.TAPPING): kept after the block
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
+
+    def _check_cycle_conditions(self, name: str) -> None:
+        """rs274 2.9's conditions on the machine for a canned cycle (raises ValueError with its message)."""
+        s = self.state
+        if s.feed <= 0:
+            raise ValueError("Cannot feed with zero feed rate")
+        if s.feed_mode == "inverse_time":
+            raise ValueError("Cannot use inverse time feed with canned cycles")
+        if s.compensating:
+            raise ValueError("Cannot use canned cycles with cutter compensation on")
+        code = _SPINDLE_CYCLES.get(name)
+        if code and s.spindle == 0:
+            raise ValueError(f"Spindle not turning in {code}")
+        if name == "cycle_tap" and s.spindle < 0:
+            raise ValueError("Spindle turning counterclockwise in G84")
+        if name == "cycle_tap_left" and s.spindle > 0:
+            raise ValueError("Spindle turning clockwise in G74")
 
     def _threading_cycle(self, params: dict, line: int) -> tuple[int, list[Waypoint]]:
         """G76: the passes of a threading cycle become waypoints (see :mod:`.threading`)."""
@@ -596,6 +617,8 @@ class ModalHandler:
                 self._check_tool(int(params["T"]), int(t.line[row]))
             s.selected_tool = int(params.get("T", s.selected_tool))
             s.tool = s.selected_tool
+            if self.machine.rs274_blocks and NAMES[int(t.name[row])] == "tool_change":
+                s.spindle = 0  # rs274 stops the spindle for the change (a G86 after M6 is refused)
 
     def _check_tool(self, number: int, line: int) -> None:
         """With a tool table, selecting a tool it lacks is LinuxCNC's error (T0, no tool, is fine)."""
