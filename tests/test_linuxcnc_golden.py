@@ -30,6 +30,11 @@ CENTRE = ["cx", "cy", "cz"]
 CANON_MOTION = {"STRAIGHT_TRAVERSE": "rapid", "STRAIGHT_FEED": "feed", "STRAIGHT_PROBE": "feed",
                 "NURBS_FEED": "spline"}
 SPLINES = [NAME_ID[n] for n in ("spline_cubic", "spline_quadratic", "nurbs_end")]
+#: gcodekit's LinuxCNC machine as rs274 run standalone behaves: it reads tool tables in inches,
+#: and its canon hands back the F number and the tool offset's numbers when G20/G21 change the
+#: units (``F30 G20`` is 30 in/min there, 30 mm/min in LinuxCNC's task)
+RS274_STANDALONE = {"machine": "linuxcnc", "tool_table_units": "inch", "units_keep_feed": True,
+                    "units_keep_tool_offset": True}
 
 
 def to_machine(x: np.ndarray, y: np.ndarray, z: np.ndarray,
@@ -71,11 +76,11 @@ def reference_table(ref: pd.DataFrame) -> pd.DataFrame:
 
 
 def first_difference(ours: pd.DataFrame, ref: pd.DataFrame, exact: list[str],
-                     close: list[str], atol: float = ATOL) -> str | None:
+                     close: list[str], atol: "float | np.ndarray" = ATOL) -> str | None:
     """Describe the first row where the tables differ, or None.
 
     ``exact`` columns must be equal; ``close`` columns must agree within
-    ``atol`` + RTOL * |reference| wherever the reference has a value.
+    ``atol`` (a number, or one per row) + RTOL * |reference| wherever the reference has a value.
     """
     n = min(len(ours), len(ref))
     a, b = ours.iloc[:n].reset_index(drop=True), ref.iloc[:n].reset_index(drop=True)
@@ -139,10 +144,7 @@ def ours_like_canon(op) -> pd.DataFrame:
 @cache
 def motions(name: str) -> tuple[pd.DataFrame, pd.DataFrame, list]:
     """(our motions, reference motions, diagnostics) of one case."""
-    # rs274 standalone reads tables in inches, and its canon hands back the F number when
-    # G20/G21 re-read the feed (``F30 G20`` is 30 in/min there, 30 mm/min in LinuxCNC's task)
-    op = gcodekit.gcode_to_operation(CASES / name, machine="linuxcnc", plan=False, tool_table=tool_table(name),
-                                     tool_table_units="inch", units_keep_feed=True)
+    op = gcodekit.gcode_to_operation(CASES / name, plan=False, tool_table=tool_table(name), **RS274_STANDALONE)
     return ours_like_canon(op), reference_motions(CASES / (name + ".canon.csv")), op.diagnostics.items
 
 

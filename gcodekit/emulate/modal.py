@@ -226,14 +226,14 @@ class ModalHandler:
             offset = self.machine.tools.offset(int(number))
             # rs274 re-reads its position after a tool change, so a G43 in the
             # M6 block keeps the program position; elsewhere the machine stays.
-            s.change_tool_offset(offset if name == "tool_length_offset" else s.tool_offset + offset,
-                                 keep_program_position=line == self._tool_change_line)
+            self._change_tool_offset(offset if name == "tool_length_offset" else self._tool_offset_held() + offset,
+                                     keep_program_position=line == self._tool_change_line)
         elif name == "tool_length_offset_dynamic":  # G43.1: the axes it names; the others keep their offsets
-            scale = s.scale()
-            s.change_tool_offset([params[letter] * scale[ax] if letter in params else s.tool_offset[ax]
-                                  for ax, letter in enumerate(AXES)])
+            scale, held = s.scale(), self._tool_offset_held()
+            self._change_tool_offset([params[letter] * scale[ax] if letter in params else held[ax]
+                                      for ax, letter in enumerate(AXES)])
         elif name == "cancel_tool_length":
-            s.change_tool_offset(np.zeros(6))
+            self._change_tool_offset(np.zeros(6))
         elif name == "coordinate_data":
             self._coordinate_data(params, line)
         elif name == "local_offset":
@@ -536,6 +536,26 @@ class ModalHandler:
                 program[ax] = program[ax] + params[letter] * scale[ax] if s.incremental else params[letter] * scale[ax]
         s.position = s.to_machine(program)
         s.program_shift[:] = 0.0
+
+    def _tool_offset_held(self) -> np.ndarray:
+        """The tool length offset (mm) the interpreter holds: with ``units_keep_tool_offset``, after G20/G21
+        the numbers it was set with, read in the units now in force."""
+        s = self.state
+        if self.machine.config.units_keep_tool_offset:
+            return s.tool_offset * (s.units / s.tool_offset_units)
+        return s.tool_offset
+
+    def _change_tool_offset(self, offset, keep_program_position: bool = False) -> None:
+        """A new tool length offset; the program position moves by the held offset's change (rs274's
+        ``current += old - new``), which the next move reaches when the held one was stale."""
+        s = self.state
+        held = self._tool_offset_held()
+        if keep_program_position or not np.any(held != s.tool_offset):
+            s.change_tool_offset(offset, keep_program_position)
+            return
+        believed = s.program_position() + held - np.asarray(offset, float)
+        s.change_tool_offset(offset)
+        s.keep_program_position(believed)
 
     def _coordinate_data(self, params: dict, line: int) -> None:
         """G10: L2/L20 set a work offset, L1/L10/L11 a tool's offsets (LinuxCNC 2.9)."""

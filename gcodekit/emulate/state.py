@@ -70,6 +70,7 @@ class MachineState:
     g92_stored: np.ndarray = field(default_factory=_zeros)  # as stored (#5211-#5219): G92.3 brings it back
     g92_on: bool = False  # #5210: set by G92, G52 and G92.3, cleared by G92.1 and G92.2
     tool_offset: np.ndarray = field(default_factory=_zeros)  # G43 tool length offset
+    tool_offset_units: float = 1.0  # mm per program unit when the offset was set (see units_keep_tool_offset)
     # rs274 keeps the program position when the tool offset changes in an M6
     # block, and turns it with a work system's new rotation: the machine reaches
     # the new frame on the next move.  Until then the program position differs
@@ -127,6 +128,7 @@ class MachineState:
         """
         before = self.program_position()
         self.tool_offset = np.asarray(offset, float).copy()
+        self.tool_offset_units = self.units
         if keep_program_position:
             self.keep_program_position(before)
 

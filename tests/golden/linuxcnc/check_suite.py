@@ -58,7 +58,7 @@ def check(program: Path, workdir: Path) -> tuple[str, str]:
     sys.path.insert(0, str(HERE))
     import gcodekit
     from errors import expected_line
-    from test_linuxcnc_golden import AXES, CENTRE, first_difference, ours_like_canon, reference_motions
+    from test_linuxcnc_golden import AXES, CENTRE, RS274_STANDALONE, first_difference, ours_like_canon, reference_motions
 
     ini, table, var = options(program)
     command = ["bash", str(SHARED_TOOLS / "run_rs274.sh"), *(["-i", str(ini)] if ini else []),
@@ -69,8 +69,8 @@ def check(program: Path, workdir: Path) -> tuple[str, str]:
     csv = workdir / "out.canon.csv"
     subprocess.run(["/usr/bin/python3", str(SHARED_TOOLS / "canon_to_csv.py"), str(canon), "-o", str(csv),
                     "--src", str(program)], capture_output=True, text=True)
-    op = gcodekit.gcode_to_operation(program, machine="linuxcnc", plan=False, tool_table=str(table or DEFAULT_TABLE),
-                                     tool_table_units="inch", units_keep_feed=True, ini_file=str(ini or ""))
+    op = gcodekit.gcode_to_operation(program, plan=False, tool_table=str(table or DEFAULT_TABLE),
+                                     ini_file=str(ini or ""), **RS274_STANDALONE)
     errors = [d for d in op.diagnostics.items if d.severity == "error"]
     shown = [str(d) for d in errors[:2]]
     if rs274.returncode != 0:

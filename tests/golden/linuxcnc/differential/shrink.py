@@ -64,8 +64,8 @@ def shrink(text: str, verdict: Verdict | None = None, budget: int = 600) -> tupl
         return text, verdict
     keeps = same_difference(verdict)
 
-    def still_fails(lines: list[str]) -> bool:
-        return keeps(judge("\n".join(lines) + "\n"))
+    def still_fails(lines: list[str]) -> bool:  # (a loop that lost its counter runs until rs274's timeout)
+        return keeps(judge("\n".join(lines) + "\n", timeout=3.0))
 
     lines = ddmin(text.rstrip("\n").split("\n"), still_fails, budget)
     small = "\n".join(lines) + "\n"
