@@ -135,8 +135,9 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
         return CycleMoves([], program.copy())
     if cycle.initial is None:
         cycle.initial = float(program[axis])
-    old = cycle.initial  # the level where the cycle mode began, program coordinates (mm)
-    r = old + cycle.r if incremental else cycle.r
+    # levels to 1e-9 mm: rs274 compares them exactly in program units, gcodekit's pass through mm and offsets
+    old = round(cycle.initial, 9)  # the level where the cycle mode began, program coordinates (mm)
+    r = round(old + cycle.r if incremental else cycle.r, 9)
     bottom = r + cycle.z if incremental else cycle.z
     if r < bottom:
         raise ValueError(f"R less than {letter.lower()} in cycle in {PLANE_NAMES[plane]} plane")
@@ -146,7 +147,7 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
     below_r = old < r
     steps: list[Step] = []
     here = program.copy()
-    level = here[axis]  # where the tool is along the drilling axis (rs274's current_cc)
+    level = round(here[axis], 9)  # where the tool is along the drilling axis (rs274's current_cc)
 
     def go(coord: float, motion: int, dwell: float = 0.0) -> None:
         here[axis] = coord
