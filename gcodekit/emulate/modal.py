@@ -595,7 +595,8 @@ class ModalHandler:
 
     def _home(self, params: dict, secondary: bool) -> list[Waypoint]:
         s = self.state
-        stored = s.home_secondary if secondary else s.home
+        # (a stale tool offset the interpreter holds shifts the machine point it aims at, see units_keep_tool_offset)
+        stored = (s.home_secondary if secondary else s.home) + s.tool_offset - self._tool_offset_held()
         given = [ax for ax, letter in enumerate(AXES) if letter in params]
         if self.machine.config.home_mode == "select":
             for ax in given or [0, 1, 2]:
@@ -618,10 +619,10 @@ class ModalHandler:
             return MOTION_NONE
         if s.incremental:
             self.machine.diagnostics.report(line, 1, "G53 is not allowed in incremental mode (G91)", kind="machine")
-        scale = s.scale()
+        scale, stale = s.scale(), s.tool_offset - self._tool_offset_held()
         for ax, letter in enumerate(AXES):
             if letter in params:
-                s.position[ax] = params[letter] * scale[ax]
+                s.position[ax] = params[letter] * scale[ax] + stale[ax]
         return motion
 
     def _tool(self, t: CommandTable, row: int, params: dict) -> None:

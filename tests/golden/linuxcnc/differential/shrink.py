@@ -49,11 +49,10 @@ def ddmin(lines: list[str], still_fails: Callable[[list[str]], bool], budget: in
 
 
 def same_difference(found: Verdict) -> Callable[[Verdict], bool]:
-    """A test that a verdict shows the difference ``found`` shows: same kind, and for errors the same message."""
+    """A test that a verdict shows the difference ``found`` shows: the same cluster (kind, and the codes of
+    the line it shows on or the error message), so that shrinking does not drift to another difference."""
     def test(verdict: Verdict) -> bool:
-        if verdict.agree or verdict.kind != found.kind:
-            return False
-        return verdict.kind in ("motions", "feeds", "count") or verdict.cluster == found.cluster
+        return not verdict.agree and verdict.cluster == found.cluster
     return test
 
 
