@@ -32,9 +32,10 @@ CANON_MOTION = {"STRAIGHT_TRAVERSE": "rapid", "STRAIGHT_FEED": "feed", "STRAIGHT
 SPLINES = [NAME_ID[n] for n in ("spline_cubic", "spline_quadratic", "nurbs_end")]
 #: gcodekit's LinuxCNC machine as rs274 run standalone behaves: it reads tool tables in inches,
 #: and its canon hands back the F number and the tool offset's numbers when G20/G21 change the
-#: units (``F30 G20`` is 30 in/min there, 30 mm/min in LinuxCNC's task)
+#: units (``F30 G20`` is 30 in/min there, 30 mm/min in LinuxCNC's task) and the last move's
+#: program point after M6 (see MachineConfig.standalone_canon)
 RS274_STANDALONE = {"machine": "linuxcnc", "tool_table_units": "inch", "units_keep_feed": True,
-                    "units_keep_tool_offset": True}
+                    "standalone_canon": True}
 
 
 def to_machine(x: np.ndarray, y: np.ndarray, z: np.ndarray,

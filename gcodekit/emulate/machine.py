@@ -362,6 +362,8 @@ class Machine:
         self.fill_state(rows, out)
 
         s.position = position[-1].copy()
+        if moving.any():
+            s.note_move()
         if s.feed_mode == "per_minute":
             s.feed = float(feed[-1])
         elif s.feed_mode == "per_rev":

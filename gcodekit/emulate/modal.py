@@ -152,6 +152,7 @@ class ModalHandler:
                 tap = self._rigid_tap(params, line)
                 if tap is not None:  # in to the bottom, then out again at the same pitch
                     s.program_shift[:] = 0.0
+                    s.note_move()
                     self._fill_passing(tap, before)
                     bottom = np.array([tap.values[k] for k in AXES.lower()])
                     self._write(out, row, bottom, MOTION_LINEAR, feed=tap.values["feed"])
@@ -160,6 +161,7 @@ class ModalHandler:
                 rate = self._thread(params, line)
                 if rate is not None:
                     s.program_shift[:] = 0.0
+                    s.note_move()
                     self._write(out, row, before, MOTION_LINEAR, feed=rate)
                     return extra
         elif name in SPLINE_NAMES or (moves and int(t.motion[row]) in SPLINE_MOTIONS):
@@ -247,6 +249,7 @@ class ModalHandler:
                 return extra
         if motion != MOTION_NONE:
             s.program_shift[:] = 0.0  # the machine has reached the offsets in force
+            s.note_move()
         if self._believed is not None:
             s.keep_program_position(self._believed)
             self._believed = None
@@ -538,10 +541,10 @@ class ModalHandler:
         s.program_shift[:] = 0.0
 
     def _tool_offset_held(self) -> np.ndarray:
-        """The tool length offset (mm) the interpreter holds: with ``units_keep_tool_offset``, after G20/G21
+        """The tool length offset (mm) the interpreter holds: with ``standalone_canon``, after G20/G21
         the numbers it was set with, read in the units now in force."""
         s = self.state
-        if self.machine.config.units_keep_tool_offset:
+        if self.machine.config.standalone_canon:
             return s.tool_offset * (s.units / s.tool_offset_units)
         return s.tool_offset
 
@@ -595,7 +598,7 @@ class ModalHandler:
 
     def _home(self, params: dict, secondary: bool) -> list[Waypoint]:
         s = self.state
-        # (a stale tool offset the interpreter holds shifts the machine point it aims at, see units_keep_tool_offset)
+        # (a stale tool offset the interpreter holds shifts the machine point it aims at, see standalone_canon)
         stored = (s.home_secondary if secondary else s.home) + s.tool_offset - self._tool_offset_held()
         given = [ax for ax, letter in enumerate(AXES) if letter in params]
         if self.machine.config.home_mode == "select":
@@ -640,6 +643,8 @@ class ModalHandler:
             s.tool = s.selected_tool
             if self.machine.rs274_blocks and NAMES[int(t.name[row])] == "tool_change":
                 s.spindle = 0  # rs274 stops the spindle for the change (a G86 after M6 is refused)
+                if self.machine.config.standalone_canon:  # it re-reads its position (see standalone_canon)
+                    s.keep_program_position(s.canon_point - s.frame - s.g92)
 
     def _check_tool(self, number: int, line: int) -> None:
         """With a tool table, selecting a tool it lacks is LinuxCNC's error (T0, no tool, is fine)."""
