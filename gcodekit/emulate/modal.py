@@ -23,7 +23,7 @@ from .cycles import CYCLES, TAPPING, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
 from .splines import SPLINE_NAMES, SplineBlocks
-from .state import AXES, MachineState
+from .state import AXES, MachineState, rotate_xy
 from .tooltable import Tool
 from . import work_systems
 
@@ -622,10 +622,18 @@ class ModalHandler:
             return MOTION_NONE
         if s.incremental:
             self.machine.diagnostics.report(line, 1, "G53 is not allowed in incremental mode (G91)", kind="machine")
-        scale, stale = s.scale(), s.tool_offset - self._tool_offset_held()
+        # rs274 (find_ends) works the target out in program coordinates from its own idea of the
+        # current point: an axis without a word keeps that point's coordinate in the turned frame
+        scale, held, program = s.scale(), self._tool_offset_held(), s.program_position()
+        target = program.copy()
+        turned = rotate_xy(program + s.g92, s.rotation)
         for ax, letter in enumerate(AXES):
-            if letter in params:
-                s.position[ax] = params[letter] * scale[ax] + stale[ax]
+            if ax < 2:
+                turned[ax] = params[letter] * scale[ax] - s.frame[ax] - held[ax] if letter in params else turned[ax]
+            elif letter in params:
+                target[ax] = params[letter] * scale[ax] - s.frame[ax] - s.g92[ax] - (held[ax] if ax == 2 else 0.0)
+        target[:2] = rotate_xy(turned, -s.rotation)[:2] - s.g92[:2]
+        s.position = s.to_machine(target)
         return motion
 
     def _tool(self, t: CommandTable, row: int, params: dict) -> None:
