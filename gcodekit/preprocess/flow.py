@@ -85,7 +85,6 @@ _LATHE_CYCLES = frozenset((70.0, 71.0, 71.1, 71.2, 72.0, 72.1, 72.2))
 # LinuxCNC subroutine file names: lower-case letters, digits, '-' and '_'.
 _FILE_NAME = re.compile(r"[a-z0-9_-]+")
 _CONDITIONS = ("if", "elseif", "while", "repeat")
-_LOOPS = ("while", "do", "repeat")
 _CLOSERS = {"endsub": "sub", "endif": "if", "endwhile": "while", "endrepeat": "repeat"}
 
 
@@ -226,6 +225,9 @@ class _Run:
         self.code = _Code("", [])
         self.pc = 0
         self.counters: dict[int, int] = {}
+        # rs274 2.9: after a ``break`` out of a ``while`` loop, the next ``while`` that closes a
+        # ``do`` does not loop back (the do's body runs once), wherever that do is
+        self.broke_while = False
 
     # -- running -------------------------------------------------------------
 
@@ -292,7 +294,10 @@ class _Run:
             # Reached from the branch before it, which ran: leave the if.
             self.pc = st.end + 1 if st.end >= 0 else self.pc + 1
         elif k == "while" and st.start >= 0:  # closes a do
-            if self._condition(st):
+            if self.broke_while:
+                self.broke_while = False
+                self.pc += 1
+            elif self._condition(st):
                 self._tick(st)
                 self.pc = st.start + 1
             else:
@@ -346,6 +351,7 @@ class _Run:
         if st.keyword == "break":
             self.counters.pop(st.start, None)
             self.pc = loop.end + 1
+            self.broke_while |= loop.keyword == "while"
         elif loop.keyword == "while":
             self._tick(st)
             self.pc = st.start
@@ -763,8 +769,8 @@ class _Run:
                     st.valid = False
                 else:
                     chain.append(i)
-            elif k in ("break", "continue"):
-                j = self._open(items, stack, st, _LOOPS)
+            elif k in ("break", "continue"):  # rs274 2.9 refuses them in a repeat loop, run or not
+                j = self._open(items, stack, st, ("while", "do"))
                 if j is not None:
                     st.start = j
             elif k == "return":
