@@ -92,6 +92,16 @@ class CycleState:
     #: ``cycle_il``): the "old Z" of every block until the mode ends
     initial: float | None = None
 
+    def keep_numbers(self, factor: float) -> None:
+        """G20/G21: rs274 2.9 keeps the cycle's numbers as they are (``convert_length_units``
+        converts none of them), so each length is now that many of the new units: times
+        ``factor``, the new units' mm over the old ones'."""
+        for name in ("r", "z", "q", "k", "initial"):
+            if getattr(self, name) is not None:
+                setattr(self, name, getattr(self, name) * factor)
+        if self.shift is not None:
+            self.shift = self.shift * factor
+
 
 def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray,
               to_machine: Callable[[np.ndarray], np.ndarray], scale: np.ndarray, plane: int, incremental: bool,

@@ -176,6 +176,8 @@ class ModalHandler:
             attr, value = _SIMPLE[name]
             if attr == "units" and keep_feed:
                 s.feed *= value / s.units  # the same F number in the new units
+            if attr == "units" and self.machine.rs274_blocks:
+                s.cycle.keep_numbers(value / s.units)
             setattr(s, attr, value)
             if attr == "feed_mode" and self.machine.rs274_blocks and "F" not in params:
                 s.feed = 0.0  # rs274 2.9: G93, G94 and G95 zero the feed rate (an F in the block is set after)
