@@ -424,6 +424,8 @@ class Machine:
             for i in np.flatnonzero(normal)[:20]:
                 self.diagnostics.report(int(t.line[rows[i]]), 1, f"{'IJK'[h]} word given for arc in "
                                         f"{arcs.PLANE_NAMES[s.plane]} plane", kind="machine")
+        if self.rs274_blocks and not np.isnan(r_word).all():
+            self._check_radius_ends(t, rows, ~np.isnan(r_word), p0, p1, "XYZ"[f] + "XYZ"[g])
         no_center = np.isnan(r_word) & np.isnan(o1) & np.isnan(o2)
         for i in np.flatnonzero(no_center)[:20]:
             self.diagnostics.report(int(t.line[rows[i]]), 1, f"arc needs {l1}/{l2} offsets or R in this plane (G{s.plane})",
@@ -448,6 +450,16 @@ class Machine:
         centre = s.to_machine(centre)
         centers[idx, f] = centre[:, f]
         centers[idx, g] = centre[:, g]
+
+    def _check_radius_ends(self, t, rows, radius_form, p0, p1, letters: str) -> None:
+        """rs274 refuses an R-form arc without an end word in its plane, or ending where it starts."""
+        words = ~np.isnan(_take(t, letters[0], rows)) | ~np.isnan(_take(t, letters[1], rows))
+        first, second = sorted(letters)
+        for i in np.flatnonzero(radius_form & ~words)[:20]:
+            self.diagnostics.report(int(t.line[rows[i]]), 1, f"{first} and {second.lower()} words missing for arc "
+                                    f"in {arcs.PLANE_NAMES[self.state.plane]} plane", kind="machine")
+        for i in np.flatnonzero(radius_form & words & (np.hypot(*(p1 - p0).T) < 1e-9))[:20]:
+            self.diagnostics.report(int(t.line[rows[i]]), 1, "Current point same as end point of arc", kind="machine")
 
     def _check_radii(self, t, rows, r0, r1, units) -> None:
         # LinuxCNC 2.9 rejects centre-format arcs whose end radius differs from the start
