@@ -352,8 +352,14 @@ class Machine:
         for ax, letter in enumerate(AXES.lower()):
             out[letter][rows] = position[:, ax]
         out["de"][rows] = de
-        # G93 gives each move a time (1/F minutes); like rs274, report the speed that makes
-        out["feed"][rows] = feed * np.where(distance > 0, distance, rotary) if s.feed_mode == "inverse_time" else feed
+        # G93 gives each move a time (1/F minutes); like rs274, report the speed that makes it, over the
+        # length from where rs274 takes the tool to be (after an offset change it may not be there yet)
+        if s.feed_mode == "inverse_time":
+            steps = np.linalg.norm((targets - np.vstack([program[None, :], targets[:-1]]))[:, :3], axis=1)
+            length = np.where(is_arc, distance, steps)
+            out["feed"][rows] = feed * np.where(length > 0, length, rotary)
+        else:
+            out["feed"][rows] = feed
         out["distance"][rows] = distance
         out["time"][rows] = time
         out["motion"][rows] = motion

@@ -552,13 +552,14 @@ class ModalHandler:
 
     def _change_tool_offset(self, offset, keep_program_position: bool = False) -> None:
         """A new tool length offset; the program position moves by the held offset's change (rs274's
-        ``current += old - new``), which the next move reaches when the held one was stale."""
+        ``current += old - new``, turned into the program frame), which the next move reaches when the
+        held one was stale."""
         s = self.state
         held = self._tool_offset_held()
         if keep_program_position or not np.any(held != s.tool_offset):
             s.change_tool_offset(offset, keep_program_position)
             return
-        believed = s.program_position() + held - np.asarray(offset, float)
+        believed = s.program_position() + rotate_xy(held - np.asarray(offset, float), -s.rotation)
         s.change_tool_offset(offset)
         s.keep_program_position(believed)
 
