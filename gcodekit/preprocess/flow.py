@@ -170,6 +170,9 @@ class ControlFlowStage:
     search_path : sequence of path, default: ()
         Directories searched, after the program's own, for ``name.ngc``
         when ``o<name> call`` names a subroutine the program lacks.
+    fanuc_subs : bool, default: True
+        Fanuc-style subprograms run (M98/M99); False refuses them, as
+        rs274 does under ``[RS274NGC] DISABLE_FANUC_STYLE_SUB``.
     max_iterations, max_call_depth, max_lines : int
         Limits; default :data:`MAX_ITERATIONS`, :data:`MAX_CALL_DEPTH`,
         :data:`MAX_LINES`.
@@ -189,12 +192,14 @@ class ControlFlowStage:
     name = "control_flow"
 
     def __init__(self, flavor: Flavor, store: ParameterStore | None = None, *,
-                 search_path: Sequence[str | os.PathLike] = (), max_iterations: int = MAX_ITERATIONS,
-                 max_call_depth: int = MAX_CALL_DEPTH, max_lines: int = MAX_LINES):
+                 search_path: Sequence[str | os.PathLike] = (), fanuc_subs: bool = True,
+                 max_iterations: int = MAX_ITERATIONS, max_call_depth: int = MAX_CALL_DEPTH,
+                 max_lines: int = MAX_LINES):
         self.flavor = flavor
         self.parameters = ParameterStage(flavor, store)
         self.store = self.parameters.store
         self.search_path = [Path(p) for p in search_path]
+        self.fanuc_subs = fanuc_subs
         self.max_iterations = max_iterations
         self.max_call_depth = max_call_depth
         self.max_lines = max_lines
@@ -499,6 +504,9 @@ class _Run:
             yield line
             if not text.lstrip().startswith("/"):  # a block-deleted end may be skipped
                 raise _Stop
+            return
+        if not self.stage.fanuc_subs:
+            self._report(line, 1, f"DISABLE_FANUC_STYLE_SUB set in INI file, but found m{code}")
             return
         rest = _remove(text, spans)
         if rest.strip(" \t" + self.separators):

@@ -76,10 +76,19 @@ class DetectRules:
     header : tuple of str
         Regular expressions searched in the first lines (slicer banners,
         ``;FLAVOR:`` lines); a match is strong evidence.
+    hints : tuple of str
+        Regular expressions searched in the code (comments left out) that
+        suggest the dialect without proving it (LinuxCNC's bracketed
+        expressions, which Fanuc macros share).
+    against : tuple of str
+        Regular expressions searched in the first lines that the dialect
+        cannot read as written (text after ``;``, Fanuc's end of block):
+        a match is strong evidence against it.
     codes : tuple of str
         Codes typical of the dialect (``M82``, ``SET_VELOCITY_LIMIT``).
     extensions : tuple of str
-        File suffixes typical of the dialect (``.ngc``, ``.nc``).
+        File suffixes typical of the dialect (``.ngc``, ``.nc``); one no
+        other flavor claims is strong evidence, a shared one a hint.
     comment : str
         The comment style the dialect mostly uses: ``";"``, ``"("`` or ``""``.
     priority : int
@@ -87,6 +96,8 @@ class DetectRules:
     """
 
     header: tuple[str, ...] = ()
+    hints: tuple[str, ...] = ()
+    against: tuple[str, ...] = ()
     codes: tuple[str, ...] = ()
     extensions: tuple[str, ...] = ()
     comment: str = ""

@@ -280,8 +280,9 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
         _check_regex(pattern, f"{path}: layer_comments")
     if get("feature_comment"):
         _check_regex(get("feature_comment"), f"{path}: feature_comment", group=True)
-    for pattern in detect.get("header", ()):
-        _check_regex(pattern, f"{path}: [detect] header")
+    for key in ("header", "hints", "against"):
+        for pattern in detect.get(key, ()):
+            _check_regex(pattern, f"{path}: [detect] {key}")
     for ext in detect.get("extensions", ()):
         if not re.fullmatch(r"\.[A-Za-z0-9_.]+", ext):
             raise ConfigError(f"{path}: [detect] extensions: {ext!r} is not a suffix such as '.ngc'")
