@@ -21,13 +21,13 @@ HEAD_CHARS = 64 * 1024
 HEAD_LINES = 4000
 
 #: Points per piece of evidence.  A header match (slicer banner, dialect-only
-#: command) outweighs any number of shared codes a short head can hold; a
-#: file extension no other flavor claims (``.ngc``) outweighs one header, one
-#: several claim (``.nc``, ``.tap``) is only a hint; what the dialect cannot
+#: command) outweighs any number of shared codes a short head can hold; the
+#: dialect's own file extension (``.ngc``) outweighs one header, one unrelated
+#: dialects share (``.nc``, ``.tap``) is only a hint; what the dialect cannot
 #: read (``against``) outweighs a header and what else a short head holds.
 HEADER_POINTS = 10.0
 AGAINST_POINTS = 20.0
-UNIQUE_EXTENSION_POINTS = 12.0
+EXTENSION_POINTS = 12.0
 SHARED_EXTENSION_POINTS = 1.0
 HINT_POINTS = 3.0
 E_WORD_POINTS = 2.0
@@ -82,6 +82,7 @@ class _Rules:
     against: tuple[re.Pattern[str], ...]
     codes: frozenset[str]
     extensions: tuple[str, ...]
+    shared_extensions: tuple[str, ...]
     comment: str
     extrudes: bool
 
@@ -101,6 +102,7 @@ def _all_rules() -> tuple[_Rules, ...]:
                 tuple(re.compile(p) for p in d.against),
                 frozenset(d.codes),
                 d.extensions,
+                d.shared_extensions,
                 d.comment,
                 "e" in flavor.words.values(),
             )
@@ -129,9 +131,9 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     banners such as ``;FLAVOR:Marlin``, dialect-only syntax such as
     LinuxCNC's ``o<name> sub`` and ``#<name>`` or Klipper's
     ``PRINT_START``), 20 taken away for each ``against`` regex found (text
-    the dialect cannot read so: words after ``;`` in Fanuc), 12 for a file
-    extension only this flavor claims (``.ngc``) and 1 for one several
-    claim (``.nc``, ``.tap``), 3 for each ``hints`` regex found in the code,
+    the dialect cannot read so: words after ``;`` in Fanuc), 12 for one of
+    the flavor's file extensions (``.ngc``) and 1 for one it shares with
+    other dialects (``.nc``, ``.tap``), 3 for each ``hints`` regex found in the code,
     2 for E words on moves if the flavor extrudes, 1 for each typical code
     present and 1 for the usual comment style.  The best score wins; equal
     scores go to the higher ``priority``.  Below 3 points the evidence is
@@ -169,7 +171,6 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     head = "\n".join(lines)
     bare = _COMMENTS.sub("", head)
     suffix = os.path.splitext(os.fspath(filename))[1].lower() if filename is not None else ""
-    claims = sum(suffix in rules.extensions for rules in _all_rules()) if suffix else 0
     present = _codes_in(head)
     style = _comment_style(lines)
     e_words = _E_WORD.search(bare) is not None
@@ -190,8 +191,11 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
                 score += HINT_POINTS
                 reasons.append(f"code matches /{pattern.pattern}/")
         if suffix and suffix in rules.extensions:
-            score += UNIQUE_EXTENSION_POINTS if claims == 1 else SHARED_EXTENSION_POINTS
-            reasons.append(f"file extension {suffix}" + ("" if claims == 1 else f" (shared by {claims} flavors)"))
+            score += EXTENSION_POINTS
+            reasons.append(f"file extension {suffix}")
+        elif suffix and suffix in rules.shared_extensions:
+            score += SHARED_EXTENSION_POINTS
+            reasons.append(f"file extension {suffix} (other dialects use it too)")
         if e_words and rules.extrudes:
             score += E_WORD_POINTS
             reasons.append("E words on moves")

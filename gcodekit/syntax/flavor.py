@@ -87,8 +87,11 @@ class DetectRules:
     codes : tuple of str
         Codes typical of the dialect (``M82``, ``SET_VELOCITY_LIMIT``).
     extensions : tuple of str
-        File suffixes typical of the dialect (``.ngc``, ``.nc``); one no
-        other flavor claims is strong evidence, a shared one a hint.
+        File suffixes of the dialect (``.ngc``, and its relatives': Marlin's
+        ``.gcode`` for Klipper): strong evidence.
+    shared_extensions : tuple of str
+        File suffixes it shares with unrelated dialects (``.nc``, ``.tap``):
+        a hint only.
     comment : str
         The comment style the dialect mostly uses: ``";"``, ``"("`` or ``""``.
     priority : int
@@ -100,6 +103,7 @@ class DetectRules:
     against: tuple[str, ...] = ()
     codes: tuple[str, ...] = ()
     extensions: tuple[str, ...] = ()
+    shared_extensions: tuple[str, ...] = ()
     comment: str = ""
     priority: int = 0
 
