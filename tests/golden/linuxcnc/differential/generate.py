@@ -396,7 +396,7 @@ class _Writer:
         if code == "G87":
             words += [CENTRE_LETTERS[a] + self.n(self.length(1, 3)), CENTRE_LETTERS[b] + self.n(self.length(-3, 3)),
                       CENTRE_LETTERS[normal] + self.n(self.length(1, 4) if m.incremental else bottom + self.length(1, 4))]
-        if self.chance(0.3) and code not in ("G74", "G84"):  # rs274 2.9 takes no L for these two
+        if self.chance(0.3) and code != "G74":  # rs274 2.9 takes no L for G74 (it does for G84)
             words.append(f"L{r.randint(2, 4)}")
             self.features.add("L repeats")
         words.append(self.feed_word())
