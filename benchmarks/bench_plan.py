@@ -63,7 +63,7 @@ def child(task: str, path: str, machine: str) -> dict:
         total = float(sim.blocklist[-1].get_segments()[-1].t_end)
         return {"seconds": seconds, "peak_mb": _peak_mb(), "base_mb": base, "print_time_s": total}
     import gcodekit
-    from gcodekit.emulate.planners import planner_settings, run_planner
+    from gcodekit.plan import planner_settings, run_planner
 
     base = _peak_mb()
     t0 = time.perf_counter()

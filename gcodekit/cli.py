@@ -1,4 +1,4 @@
-"""Command line: ``gcodekit info``, ``export``, ``render``, ``translate`` and ``report``.
+"""Command line: ``gcodekit info``, ``export``, ``render``, ``translate``, ``report`` and ``notebook``.
 
 Examples
 --------
@@ -10,6 +10,7 @@ Examples
     gcodekit export print.gcode --to vtk -o print.vtp
     gcodekit render print.gcode -o print.png --color-by speed --view top
     gcodekit report *.gcode -o reports/ --workers 2
+    gcodekit notebook part.gcode -o part.ipynb
 """
 
 from __future__ import annotations
@@ -22,23 +23,35 @@ import sys
 from pathlib import Path
 from typing import Any, Sequence
 
-from .errors import ConfigError, GcodeError
+from .errors import ConfigError, GcodeError, MissingDependencyError, NothingToShowError
+from .limits import MAX_ITERATIONS, MAX_MOTIONS
+
+#: Exit statuses: a program with errors, bad usage or options, and a bug in gcodekit itself.
+EXIT_PROGRAM_ERROR, EXIT_USAGE, EXIT_INTERNAL = 1, 2, 3
 
 EXPORT_FORMATS = ("csv", "parquet", "vtk", "events")
 #: Output file name ending of each format when ``-o`` is not given (None: standard output).
 _DEFAULT_SUFFIX = {"csv": None, "events": None, "parquet": ".parquet", "vtk": ".vtp"}
 
 
+class UsageError(ValueError):
+    """A command-line argument that cannot work (exit status 2)."""
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="gcodekit", description="Read, emulate and summarise G-code programs.")
+    debug = argparse.ArgumentParser(add_help=False)
+    debug.add_argument("--debug", action="store_true",
+                       help="on an internal error, print the traceback (for a bug report)")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    add = lambda name, **kw: sub.add_parser(name, parents=[debug], **kw)  # noqa: E731
 
-    info = sub.add_parser("info", help="summarise programs: flavor, moves, bounds, distances, time")
+    info = add("info", help="summarise programs: flavor, moves, bounds, distances, time")
     info.add_argument("files", nargs="+", metavar="FILE")
     _common(info)
     info.add_argument("--json", action="store_true", help="one JSON object per file (a list when several)")
 
-    export = sub.add_parser("export", help="write the motions of a program to a table, a VTK mesh or an event series")
+    export = add("export", help="write the motions of a program to a table, a VTK mesh or an event series")
     export.add_argument("file", metavar="FILE")
     _common(export)
     export.add_argument("--to", choices=EXPORT_FORMATS, default="csv",
@@ -51,7 +64,7 @@ def _parser() -> argparse.ArgumentParser:
                              ".parquet or .vtp in the current directory otherwise)")
     export.add_argument("-f", "--force", action="store_true", help="overwrite OUT if it exists")
 
-    render = sub.add_parser("render", help="draw the toolpath to a PNG, off-screen")
+    render = add("render", help="draw the toolpath to a PNG, off-screen")
     render.add_argument("file", metavar="FILE")
     _common(render)
     render.add_argument("-o", "--output", metavar="OUT", required=True, help="PNG file to write")
@@ -65,7 +78,7 @@ def _parser() -> argparse.ArgumentParser:
     render.add_argument("--size", default="1200x900", metavar="WxH", help="image size in pixels (default: 1200x900)")
     render.add_argument("-f", "--force", action="store_true", help="overwrite OUT if it exists")
 
-    translate = sub.add_parser("translate", help="simplify a mill program stage by stage (GER's transpiler)")
+    translate = add("translate", help="simplify a mill program stage by stage (GER's transpiler)")
     translate.add_argument("file", metavar="FILE")
     _common(translate)
     translate.add_argument("--stage", type=int, default=6, choices=range(7), metavar="K",
@@ -75,7 +88,7 @@ def _parser() -> argparse.ArgumentParser:
     translate.add_argument("-o", "--output", metavar="OUT", help="output file (default: standard output)")
     translate.add_argument("-f", "--force", action="store_true", help="overwrite OUT if it exists")
 
-    report = sub.add_parser("report", help="an HTML and PDF report per program, and an index page")
+    report = add("report", help="an HTML and PDF report per program, and an index page")
     report.add_argument("files", nargs="+", metavar="PROGRAM")
     report.add_argument("-o", "--output", required=True, metavar="DIR", help="directory for the reports")
     report.add_argument("--machine", help="machine preset (default: the one for the flavor)")
@@ -88,13 +101,28 @@ def _parser() -> argparse.ArgumentParser:
     report.add_argument("--notebook-html", action="store_true", help="with --notebook: also convert it to HTML")
     report.add_argument("--strict", action="store_true",
                         help="a program with an error gets an error page instead of a report")
+    _limits(report)
     report.add_argument("-f", "--force", action="store_true", help="overwrite existing reports in DIR")
     report.add_argument("--no-progress", action="store_true", help="never show a progress bar")
+
+    notebook = add("notebook", help="write a notebook exploring a program with the widgets")
+    notebook.add_argument("file", metavar="PROGRAM")
+    notebook.add_argument("-o", "--output", required=True, metavar="NAME.ipynb", help="notebook to write")
+    notebook.add_argument("--machine", help="machine preset (default: the one for the flavor)")
+    notebook.add_argument("--machine-config", metavar="FILE",
+                          help="the firmware's own settings for the machine's planner (Klipper printer.cfg)")
+    notebook.add_argument("--execute", action="store_true", help="run it, so it opens with its outputs")
+    notebook.add_argument("--html", action="store_true",
+                          help="also write NAME.html that shows its pictures offline (runs it)")
+    notebook.add_argument("-f", "--force", action="store_true", help="overwrite NAME.ipynb if it exists")
     return p
 
 
 def _positive(text: str) -> int:
-    value = int(text)
+    try:
+        value = int(text.replace("_", "").replace(",", ""))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a whole number, not {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"needs 1 or more, not {value}")
     return value
@@ -107,27 +135,54 @@ def _common(p: argparse.ArgumentParser) -> None:
                    help="the firmware's own settings for the machine's planner (Klipper printer.cfg)")
     p.add_argument("--strict", action="store_true", help="stop at the first error instead of reporting it")
     p.add_argument("--no-progress", action="store_true", help="never show a progress bar")
+    _limits(p)
+
+
+def _limits(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--max-motions", type=_positive, default=MAX_MOTIONS, metavar="N",
+                   help=f"stop a program that makes more motions than this (default: {MAX_MOTIONS:,})")
+    p.add_argument("--max-iterations", type=_positive, default=MAX_ITERATIONS, metavar="N",
+                   help=f"stop a program whose loops run more iterations than this (default: {MAX_ITERATIONS:,})")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``gcodekit`` command; returns the exit status."""
+    """Entry point of the ``gcodekit`` command; returns the exit status.
+
+    Problems with the programs or the arguments are one-line messages (status
+    1 or 2); anything else is a bug in gcodekit, said to be one (status 3,
+    the traceback with ``--debug``).
+    """
     args = _parser().parse_args(argv)
     try:
-        if args.command == "info":
-            return _info(args)
-        if args.command == "translate":
-            return _translate(args)
-        if args.command == "render":
-            return _render(args)
-        if args.command == "report":
-            return _report(args)
-        return _export(args)
-    except (GcodeError, FileNotFoundError, FileExistsError, IsADirectoryError, PermissionError, ValueError,
-            ImportError) as exc:
+        return _COMMANDS[args.command](args)
+    except (GcodeError, UsageError, OSError) as exc:
         print(f"gcodekit: error: {exc}", file=sys.stderr)
-        return 1 if isinstance(exc, GcodeError) and not isinstance(exc, ConfigError) else 2
+        return EXIT_PROGRAM_ERROR if isinstance(exc, GcodeError) and not isinstance(
+            exc, (ConfigError, MissingDependencyError)) else EXIT_USAGE
     except BrokenPipeError:
         return 0
+    except MemoryError:
+        print("gcodekit: error: out of memory; the program is too large for this machine "
+              "(--max-motions stops it earlier)", file=sys.stderr)
+        return EXIT_PROGRAM_ERROR
+    except KeyboardInterrupt:
+        return 130
+    except Exception as exc:  # noqa: BLE001 -- a bug, told apart from bad input
+        return _internal_error(exc, args.debug)
+
+
+def _internal_error(exc: Exception, debug: bool) -> int:
+    from . import __version__
+
+    if debug:
+        import traceback
+
+        traceback.print_exc()
+    print(f"gcodekit: internal error: {type(exc).__name__}: {exc}\n"
+          f"  This is a bug in gcodekit {__version__}, not a problem with the program; please report it "
+          "with the program and the command." + ("" if debug else "\n  Run the command again with --debug "
+                                                  "for the traceback."), file=sys.stderr)
+    return EXIT_INTERNAL
 
 
 def _load(path: str, args: argparse.Namespace):
@@ -139,7 +194,8 @@ def _load(path: str, args: argparse.Namespace):
         raise IsADirectoryError(f"{path} is a directory, not a program")
     progress = sys.stderr.isatty() and not args.no_progress and os.path.getsize(path) > 2_000_000
     return gcode_to_operation(Path(path), args.machine, flavor=args.flavor, machine_config=args.machine_config,
-                              mode="strict" if args.strict else "lenient", progress=progress)
+                              mode="strict" if args.strict else "lenient", progress=progress,
+                              max_motions=args.max_motions, max_iterations=args.max_iterations)
 
 
 def summary(op) -> dict[str, Any]:
@@ -255,7 +311,7 @@ def _export(args: argparse.Namespace) -> int:
         output = Path(args.file).name.removesuffix(".gz")
         output = str(Path(output).with_suffix(_DEFAULT_SUFFIX[args.to]))
     if args.to == "vtk" and output and Path(output).suffix.lower() not in (".vtk", ".vtp"):
-        raise ValueError(f"{output}: a VTK export is written to a .vtp or .vtk file")
+        raise UsageError(f"{output}: a VTK export is written to a .vtp or .vtk file")
     if _exists(output, args):
         return 2
     op = _load(args.file, args)
@@ -266,7 +322,7 @@ def _export(args: argparse.Namespace) -> int:
         try:
             op.motions().to_parquet(target, index=False)
         except ImportError as exc:
-            raise ImportError("parquet export needs pyarrow: pip install 'gcodekit[parquet]'") from exc
+            raise MissingDependencyError("parquet export needs pyarrow: pip install 'gcodekit[parquet]'") from exc
     elif args.to == "events":
         from .analysis import gcode_dataframe_to_event_series
 
@@ -276,11 +332,11 @@ def _export(args: argparse.Namespace) -> int:
         from .additive import AdditivePart, VTKExporter
 
         if op.machine.process != "additive":
-            raise ValueError(f"{args.file}: VTK export is for additive programs; machine {op.machine.name!r} "
+            raise UsageError(f"{args.file}: VTK export is for additive programs; machine {op.machine.name!r} "
                              f"is {op.machine.process}")
         part = AdditivePart(op)
         if part.depositions.empty:
-            raise ValueError(f"{args.file}: no deposition moves to export")
+            raise NothingToShowError(f"{args.file}: no deposition moves to export")
         VTKExporter.additive_part_to_vtk(part, output)
     _report_errors(op)
     return 0
@@ -294,9 +350,9 @@ def _render(args: argparse.Namespace) -> int:
     except ValueError:
         size = ()
     if len(size) != 2 or min(size) < 16:
-        raise ValueError(f"--size {args.size!r}: give width x height in pixels, e.g. 1200x900")
+        raise UsageError(f"--size {args.size!r}: give width x height in pixels, e.g. 1200x900")
     if Path(args.output).suffix.lower() != ".png":
-        raise ValueError(f"{args.output}: render writes a .png file")
+        raise UsageError(f"{args.output}: render writes a .png file")
     if _exists(args.output, args):
         return 2
     op = _load(args.file, args)
@@ -348,7 +404,8 @@ def _report(args: argparse.Namespace) -> int:
             return 2
     config = os.path.abspath(args.machine_config) if args.machine_config else None
     options = ReportOptions(machine=args.machine, machine_config=config, pdf=not args.no_pdf,
-                            notebook=args.notebook, notebook_html=args.notebook_html, strict=args.strict)
+                            notebook=args.notebook, notebook_html=args.notebook_html, strict=args.strict,
+                            max_motions=args.max_motions, max_iterations=args.max_iterations)
     rows = write_reports(args.files, args.output, options=options, workers=args.workers, dask=args.dask,
                          progress=sys.stderr.isatty() and not args.no_progress, force=args.force)
     for r in rows:
@@ -358,6 +415,26 @@ def _report(args: argparse.Namespace) -> int:
     print(f"{len(rows) - failed} of {len(rows)} reports written to {os.path.join(args.output, 'index.html')}")
     return 1 if failed else 0
 
+
+def _notebook(args: argparse.Namespace) -> int:
+    from .widgets.notebook import write_exploration_notebook
+
+    if Path(args.output).suffix != ".ipynb":
+        raise UsageError(f"{args.output}: a notebook is written to a .ipynb file")
+    if _exists(args.output, args):
+        return 2
+    if args.machine:
+        from .emulate.presets import load_machine
+
+        load_machine(args.machine)
+    write_exploration_notebook(args.file, args.output, machine=args.machine, machine_config=args.machine_config,
+                               execute=args.execute, html=args.html)
+    print(f"notebook written to {args.output}" + (" (and its .html)" if args.html else ""))
+    return 0
+
+
+_COMMANDS = {"info": _info, "export": _export, "render": _render, "translate": _translate, "report": _report,
+             "notebook": _notebook}
 
 if __name__ == "__main__":
     sys.exit(main())

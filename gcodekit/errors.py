@@ -66,8 +66,20 @@ class GcodeMachineError(GcodeError, ValueError):
     """The machine cannot carry out a command (bad arc, missing word, ...)."""
 
 
+class ProgramFileError(GcodeError, OSError):
+    """The program file cannot be read as text (a damaged archive, binary data)."""
+
+
 class ConfigError(GcodeError, ValueError):
     """A flavor, machine preset or option is invalid."""
+
+
+class NothingToShowError(GcodeError, ValueError):
+    """The program has nothing an output needs (no moves to draw, no deposition to export)."""
+
+
+class MissingDependencyError(GcodeError, ImportError):
+    """An optional feature's library is not installed; the message says which extra to install."""
 
 
 _ERROR_TYPES: dict[str, type[GcodeError]] = {
@@ -75,6 +87,7 @@ _ERROR_TYPES: dict[str, type[GcodeError]] = {
     "expression": GcodeExpressionError,
     "limit": GcodeLimitError,
     "machine": GcodeMachineError,
+    "file": ProgramFileError,
 }
 
 

@@ -28,10 +28,11 @@ from .emulate.operation import OPERATION_CLASSES, Operation
 from .emulate.presets import MachineConfig, default_machine_for, load_machine, with_options
 from .emulate.state_parameters import is_state_parameter, is_stored_parameter, machine_parameter, set_machine_parameter
 from .errors import ConfigError, Diagnostics, GcodeError, check_choice
+from .limits import MAX_ITERATIONS, MAX_MOTIONS, Limits
 from .memory import release_freed_memory
 from .parse import CommandTable, GcodeParser
 from .parse.table import NAME_ID
-from .read import Blocks, iter_blocks, iter_lines, read_source_lines
+from .read import CHUNK_LINES, Blocks, iter_blocks, iter_lines, iter_source_blocks, read_source_lines
 from .read.percent import until_closing_percent
 from .syntax import Detection, Flavor, detect_flavor, load_flavor
 
@@ -58,8 +59,9 @@ class Program:
     text: str | None = None
     preprocessed: bool = False  # the preprocess stage ran (and checked how the file ends)
 
-    def chunks(self) -> Iterator[bytes]:
-        return iter_lines(self.path if self.path is not None else self.text)
+    def chunks(self, diagnostics: Diagnostics | None = None) -> Iterator[bytes]:
+        """The program's chunks of whole lines; problems with the file go to ``diagnostics``, if given."""
+        return iter_lines(self.path if self.path is not None else self.text, diagnostics)
 
     def head(self, size: int = 65536) -> str:
         if self.text is not None:
@@ -152,7 +154,8 @@ def emulate_operation(operation: Operation, machine: str | MachineConfig | None 
 def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig | None = None, *,
                        flavor: str | Flavor | None = None, mode: str = "lenient",
                        progress: bool = False, machine_config: str | os.PathLike | None = None,
-                       plan: bool = True, **machine_options) -> Operation:
+                       plan: bool = True, max_motions: int = MAX_MOTIONS, max_iterations: int = MAX_ITERATIONS,
+                       **machine_options) -> Operation:
     """Read, parse and emulate a program into an :class:`Operation`.
 
     Parameters
@@ -173,6 +176,10 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         machine's planner; its values replace the preset's.
     plan : bool, default: True
         Time the moves with the machine's motion planner, if it has one.
+    max_motions, max_iterations : int, default: 50 million, 100 000
+        Limits on the motions the program may make and the loop iterations
+        it may run; a program that passes one stops there with an error
+        naming the line (see :mod:`gcodekit.limits`).
     **machine_options
         Override preset values (``rapid_feed=5000``).
 
@@ -187,12 +194,13 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     ((10.0, 5.0), 1.0)
     """
     check_choice("mode", mode, ("lenient", "strict"))
+    limits = Limits(max_motions, max_iterations)
     program = as_program(source)
     fl, config, detection = resolve(program, machine, flavor, **machine_options)
     if machine_config is not None:
         if not config.planner:
             raise ConfigError(f"machine {config.name!r} has no planner to read {os.fspath(machine_config)!r}")
-        from .emulate.planners import machine_options as firmware_options
+        from .plan import machine_options as firmware_options
 
         config = dataclasses.replace(config, **firmware_options(config.planner, machine_config))
     diagnostics = Diagnostics(program.name, mode)
@@ -203,7 +211,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     machine_diagnostics.elsewhere = diagnostics.elsewhere
     m = Machine(config, machine_diagnostics, rapid_is_feed=fl.rapid_is_feed, initial_units=fl.units,
                 initial_extrusion=fl.extrusion, rs274_blocks=fl.block_split == "modal",
-                polar_incremental_only=fl.polar_incremental_only)
+                polar_incremental_only=fl.polar_incremental_only, max_motions=limits.max_motions)
     tables, waypoints, n_lines = [], [], 0
     bar = _progress(program, progress)
 
@@ -216,7 +224,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
 
     reading_error = None
     try:
-        for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate),
+        for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate), limits=limits,
                                      search_path=config.subroutine_path + (m.ini.subroutine_path if m.ini else ()),
                                      fanuc_subs=m.ini.fanuc_subs if m.ini else True):
             emulate(blocks, lines)
@@ -231,8 +239,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         waypoints, sizes = [m.run(table)], [0]
     if fl.percent_delimiter and program.path is not None and not program.preprocessed and reading_error is None:
         _check_program_end(program, table, n_lines, machine_diagnostics)  # rs274 finds it after the last line ran
-    op = cls(table, _concat_waypoints(waypoints, sizes), file=program.name,
-             flavor=fl, machine=config, diagnostics=machine_diagnostics, n_lines=n_lines)
+    op = cls(table, _concat_waypoints(waypoints, sizes), file=program.name, flavor=fl, machine=config,
+             diagnostics=machine_diagnostics, n_lines=n_lines, max_motions=limits.max_motions)
     del tables, waypoints
     release_freed_memory()  # the reader's per-chunk garbage, before the planner's arrays
     from .emulate.compensation import compensate, uses_compensation
@@ -244,7 +252,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         diagnostics.extend(machine_diagnostics)  # its warnings
         op.diagnostics = diagnostics
     if plan and config.planner:
-        from .emulate.planners import planner_settings, run_planner
+        from .plan import planner_settings, run_planner
 
         run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
     _restore_line_numbers(op.table, diagnostics)
@@ -263,7 +271,8 @@ def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineCon
 
 def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None,
             machine: tuple[Machine, Callable[[Blocks, int], None]] | None = None,
-            search_path: Sequence[str] = (), fanuc_subs: bool = True) -> Iterator[tuple[Blocks, int]]:
+            search_path: Sequence[str] = (), limits: Limits = Limits(),
+            fanuc_subs: bool = True) -> Iterator[tuple[Blocks, int]]:
     """Blocks of the program chunk by chunk, preprocessed when it needs it.
 
     With ``machine`` (the machine and a function that parses and emulates
@@ -276,18 +285,20 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         from .preprocess import ControlFlowStage, ParameterStore, SourceLine, needs_parameters, run_stages
         from .preprocess.wizards import WizardStage, needs_wizards
 
-        text = program.text if program.text is not None else b"".join(program.chunks()).decode("utf-8", "replace")
+        text = b"".join(program.chunks(diagnostics)).decode("utf-8", "replace")
         if flavor.percent_delimiter:  # nothing after a closing % line is read, as in rs274
             text = b"".join(until_closing_percent(iter_lines(text))).decode("utf-8", "surrogateescape")
         # probes and reads of their results may sit in subroutine files: watch every program
         # (until a probe goes by, the watch only collects the lines)
         feedback = _MachineFeedback(flavor, diagnostics, *machine) if machine is not None else None
         store = ParameterStore(system=feedback.system, system_writes=feedback) if feedback is not None else None
-        stages = [ControlFlowStage(flavor, store, search_path=search_path, fanuc_subs=fanuc_subs)] if flavor.parameters and (
+        stages = [ControlFlowStage(flavor, store, search_path=search_path, fanuc_subs=fanuc_subs,
+                                   max_iterations=limits.max_iterations,
+                                   max_motions=limits.max_motions)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text) or _SUBPROGRAM_M.search(text)) else []
         if not stages:
             feedback = None  # no parameters for the machine to give
-        stages += [WizardStage(flavor)] if flavor.wizards and needs_wizards(text) else []
+        stages += [WizardStage(flavor, max_motions=limits.max_motions)] if flavor.wizards and needs_wizards(text) else []
         if stages:
             program.preprocessed = True
             lines = text.split("\n")
@@ -302,18 +313,18 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
                 out = _number_other_files(out, program.name, diagnostics)
                 if feedback is not None:
                     out = feedback.watch(out, store)
-                yield _MachineStop.read(out, flavor, diagnostics), len(lines)
+                yield from _MachineStop.read(out, flavor, diagnostics, len(lines))
                 diagnostics.extend(d for d in early if d.severity != "error")
                 early.raise_first()
                 return
             out = _number_other_files(run_stages(source, stages, diagnostics), program.name, diagnostics)
             if feedback is not None:
                 out = feedback.watch(out, store)
-            yield _MachineStop.read(out, flavor, diagnostics), len(lines)
+            yield from _MachineStop.read(out, flavor, diagnostics, len(lines))
             return
         chunks: Iterator[bytes] = iter_lines(text)
     else:
-        chunks = program.chunks()
+        chunks = program.chunks(diagnostics)
     if flavor.percent_delimiter:
         chunks = until_closing_percent(chunks)
     sizes: list[int] = []
@@ -392,18 +403,24 @@ class _MachineFeedback:
         self.state_parameters = flavor.state_parameters == "linuxcnc"
 
     def watch(self, lines: Iterator, store) -> Iterator:
-        """Pass ``lines`` on, noting probe moves; yields only the lines left at the end."""
+        """Pass ``lines`` on, noting probe moves; yields only the lines left at the end.
+
+        Held lines are emulated every :data:`~gcodekit.read.CHUNK_LINES`
+        lines, so a long loop's output is never held whole.
+        """
         self.store = store
         for line in lines:
             self.held.append(line)
             if _PROBE_LINE.search(line.text.split(";")[0].split("(")[0]):
                 self.probed = True
+            if len(self.held) >= CHUNK_LINES:
+                self._catch_up()
         yield from self.held
 
     def system(self, key: int | str) -> float | None:
         """The store's system-parameter hook: the machine's value of ``key``, or None."""
         if key in _PROBE_RESULTS:
-            if self.probed and self.held:
+            if self.probed:  # held lines may hold a probe; earlier ones were emulated already
                 self._catch_up()
                 self._store_probe_results()
             return None
@@ -448,9 +465,16 @@ class _MachineStop(Exception):
         self.error = error
 
     @staticmethod
-    def read(lines: Iterator, flavor: Flavor, diagnostics: Diagnostics) -> Blocks:
+    def read(lines: Iterator, flavor: Flavor, diagnostics: Diagnostics, n_lines: int) -> Iterator[tuple[Blocks, int]]:
+        """Preprocessed ``lines`` read a chunk at a time; the last chunk carries the program's
+        ``n_lines``."""
         try:
-            return read_source_lines(lines, flavor, diagnostics)
+            chunks = iter_source_blocks(lines, flavor, diagnostics)
+            blocks = next(chunks)
+            for following in chunks:
+                yield blocks, 0
+                blocks = following
+            yield blocks, n_lines
         except _MachineStop as stop:
             raise stop.error from None
 
@@ -534,7 +558,7 @@ def _concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarr
     for key in list(parts[0]):
         cols = [p.pop(key) for p in parts]
         first = cols[0][0] if cols[0].size else None
-        if key != "command" and all(c.strides == (0,) for c in cols) and all(
+        if key != "command" and first is not None and all(c.strides == (0,) for c in cols) and all(
                 (c[0] == first) or (c[0] != c[0] and first != first) for c in cols if c.size):
             out[key] = np.broadcast_to(first, (sum(c.size for c in cols),))
         else:

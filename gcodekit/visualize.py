@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import check_choice
+from .errors import NothingToShowError, check_choice
 
 if TYPE_CHECKING:
     import pyvista as pv
@@ -195,7 +195,8 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
     scalars = scalars or default_scalars(op)
     mesh, travel, categories = operation_polydata(op, scalars)
     if mesh.n_cells == 0 and (travel.n_cells == 0 or not show_travel):
-        raise ValueError(f"{op.file}: nothing to draw (no {'deposition' if _is_additive(op) else 'feed'} moves)")
+        raise NothingToShowError(f"{op.file}: nothing to draw (no {'deposition' if _is_additive(op) else 'feed'} "
+                                 "moves)")
     plotter = pv.Plotter(off_screen=off_screen, window_size=list(window_size))
     plotter.set_background(background)
     bar: dict[str, Any] = dict(title=NAMED_SCALARS.get(scalars, scalars), color="black", vertical=True,
@@ -266,7 +267,7 @@ def plot_layer(source: "Operation | AdditivePart", layer: int, *, ax: "Axes | No
     in_layer = (source.waypoint_layer if hasattr(source, "waypoint_layer") else analysis.layers(op)) == layer
     work, travel = move_masks(op)
     if not (work & in_layer).any():
-        raise ValueError(f"{op.file}: layer {layer} has no deposition moves")
+        raise NothingToShowError(f"{op.file}: layer {layer} has no deposition moves")
     if ax is None:
         import matplotlib.pyplot as plt
 

@@ -1,12 +1,12 @@
 """Bad input: random bytes and mutated real programs through the whole pipeline.
 
 Lenient mode must never raise; strict mode may raise only gcodekit's own
-errors; neither may hang (hypothesis' deadline catches slow cases).
+errors.  Hangs and memory are the fuzz suite's to catch (tests/test_fuzz.py
+runs each case in a process of its own, with limits): no clock here.
 """
 
 from __future__ import annotations
 
-from datetime import timedelta
 from pathlib import Path
 
 import pytest
@@ -23,7 +23,7 @@ SAMPLES = {
     "beckhoff_ded": (EXAMPLES / "dome_ded_beckhoff.nc").read_text().splitlines()[:200],
 }
 MACHINES = {"marlin": "marlin", "rs274ngc": "linuxcnc", "beckhoff_ded": "beckhoff_ded"}
-SETTINGS = settings(max_examples=150, deadline=timedelta(seconds=5),
+SETTINGS = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 
 

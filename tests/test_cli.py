@@ -78,3 +78,28 @@ def test_translate_writes_plain_gcode(tmp_path, capsys):
     assert body[0] == "G21"  # the output names its units
     assert body[1:] and all(line.split()[1] in ("G0", "G1", "G2", "G3", "G4", "M2", "M3", "M5", "M6", "M8", "M9",
                                                 "M30") for line in body[1:])
+
+
+def test_a_bug_is_told_apart_from_bad_input(capsys, monkeypatch):
+    """An exception gcodekit does not expect is an internal error (status 3), never 'bad input'."""
+    import gcodekit.pipeline
+
+    def broken(*args, **kwargs):
+        raise ValueError("an invariant did not hold")
+
+    monkeypatch.setattr(gcodekit.pipeline, "gcode_to_operation", broken)
+    status, _, err = run(["info", MILL], capsys)
+    assert status == cli.EXIT_INTERNAL == 3
+    assert err.startswith("gcodekit: internal error: ValueError: an invariant did not hold")
+    assert f"gcodekit {gcodekit.__version__}" in err and "--debug" in err and "Traceback" not in err
+    status, _, err = run(["info", MILL, "--debug"], capsys)
+    assert status == 3 and "Traceback (most recent call last)" in err and 'raise ValueError("an invariant' in err
+
+
+def test_bad_input_and_bad_arguments_have_their_own_statuses(tmp_path, capsys):
+    status, _, err = run(["render", MILL, "-o", tmp_path / "x.png", "--size", "3"], capsys)
+    assert status == cli.EXIT_USAGE and "--size '3'" in err and "internal" not in err
+    bad = tmp_path / "bad.ngc"
+    bad.write_text("G21\nG2 X10 Y0 R1 F100\nM2\n")
+    status, _, err = run(["export", bad, "--to", "csv", "--strict"], capsys)
+    assert status == cli.EXIT_PROGRAM_ERROR and f"{bad}:2:" in err

@@ -6,8 +6,6 @@ subroutines with local #1..#30 and named locals, return values in
 limits that end runaway programs with an error naming the line.
 """
 
-import time
-
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -188,8 +186,19 @@ def test_unknown_subroutine_is_an_error_with_a_suggestion():
 def test_file_names_cannot_leave_the_search_path(tmp_path):
     (tmp_path / "x.ngc").write_text("o<x> sub\no<x> endsub\n")
     (tmp_path / "sub").mkdir()
-    _, diagnostics = run("o<../x> call", mode="lenient", search_path=[tmp_path / "sub"])
-    assert "unknown subroutine" in diagnostics.errors[0].message
+    for name in ("../x", "sub/../../x", "..\\x", "/etc/passwd"):
+        _, diagnostics = run(f"o<{name}> call", mode="lenient", search_path=[tmp_path / "sub"])
+        assert len(diagnostics.errors) == 1
+        assert "called by its name, not a path" in diagnostics.errors[0].message
+
+
+def test_subroutine_files_linked_from_elsewhere_are_not_read(tmp_path):
+    outside = tmp_path / "outside.ngc"
+    outside.write_text("o<x> sub\nG0 X9\no<x> endsub\n")
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "x.ngc").symlink_to(outside)
+    out, diagnostics = run("o<x> call", mode="lenient", search_path=[tmp_path / "lib"])
+    assert out == [] and "links to a file outside" in diagnostics.items[0].message
 
 
 @pytest.mark.parametrize("program, line, message", [
@@ -248,12 +257,10 @@ G0 X#<_value>
     assert texts(program) == ["G0 X720"]
 
 
-def test_infinite_loop_hits_the_iteration_limit_quickly():
-    started = time.perf_counter()
-    with pytest.raises(GcodeLimitError, match=r"t\.ngc:2:1: .*more than 1000000 loop iterations"):
+def test_infinite_loop_hits_the_iteration_limit():
+    with pytest.raises(GcodeLimitError, match=r"t\.ngc:2:1: .*more than max_iterations=100,000 loop iterations"):
         run("o1 while [1]\no1 endwhile")
-    assert time.perf_counter() - started < 20
-    with pytest.raises(GcodeLimitError, match=r"t\.ngc:3:1: .*more than 10000 loop iterations"):
+    with pytest.raises(GcodeLimitError, match=r"t\.ngc:3:1: .*more than max_iterations=10,000 loop iterations"):
         run("o1 while [1]\n#1 = [#1 + 1]\no1 endwhile", max_iterations=10_000)
     out, diagnostics = run("o1 do\nG0 X1\no1 while [1]\nG0 X2", mode="lenient", max_iterations=5)
     assert len(out) == 6 and diagnostics.errors[0].line == 3

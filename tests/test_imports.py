@@ -3,7 +3,8 @@
 import subprocess
 import sys
 
-HEAVY = ["pandas", "pyvista", "vtk", "matplotlib", "ipywidgets", "trame", "jinja2", "tqdm", "hypothesis", "scipy"]
+HEAVY = ["pandas", "pyvista", "vtk", "matplotlib", "ipywidgets", "anywidget", "trame", "jinja2", "tqdm", "hypothesis",
+         "scipy"]
 
 
 def test_import_is_light():

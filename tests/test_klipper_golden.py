@@ -28,7 +28,7 @@ def test_case_totals_within_a_millisecond(case):
     program, _, variant = case.partition(".")
     options = {"temperature_waits_flush": True} if variant == "temp_wait_flush" else {}
     op = gcodekit.gcode_to_operation(CASES / f"{program}.gcode", "klipper", machine_config=CONFIG, plan=False)
-    from gcodekit.emulate.planners import planner_settings, run_planner
+    from gcodekit.plan import planner_settings, run_planner
 
     settings = planner_settings("klipper", {}, CONFIG)
     if options:

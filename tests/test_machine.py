@@ -557,3 +557,24 @@ def test_words_their_code_or_motion_mode_uses_pass():
             "G82 X1 Y1 Z-1 R1 P2\nG80 G4 P1\nG10 L2 P1 R30\nG64 P0.1 Q0.1\nM2\n")
     op, _ = run(text)
     assert not [d for d in op.diagnostics.items if "word with no" in d.message]
+
+
+@pytest.mark.parametrize("program, message", [
+    ("T99999999 M6\nG1 X1 F100\n", "no tool table: tool 99999999"),
+    ("G43 H99999999\nG1 X1 F100\n", "no tool table: tool 99999999"),
+    ("T2147483648 M6\n", "Tool number 2147483648 out of range"),
+    ("M6 T-5\n", "Negative tool id used"),
+    ("G43 H-1\n", "H word -1 out of range"),
+])
+def test_tools_a_mill_cannot_have_are_said(program, message):
+    """Issue 14: tools with no table, or numbers no tool table holds, were accepted silently."""
+    op = gcodekit.gcode_to_operation(program + "M2\n", "linuxcnc", plan=False)
+    (diagnostic,) = op.diagnostics.items
+    assert diagnostic.line == 1 and message in diagnostic.message
+
+
+def test_one_warning_for_every_tool_without_a_table():
+    op = gcodekit.gcode_to_operation("T1 M6\nG43 H1\nT2 M6\nG43 H2\nM2\n", "linuxcnc", plan=False)
+    assert [d.severity for d in op.diagnostics] == ["warning"]
+    printer = gcodekit.gcode_to_operation("T1\nG1 X1 E1 F100\nT0\n", "marlin", plan=False)
+    assert not printer.diagnostics.items  # extruders need no table

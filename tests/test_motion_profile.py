@@ -11,17 +11,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import gcodekit
-from gcodekit.emulate.motion import (
-    BAAMMotionProfile,
-    ConstantVelocity,
-    LinearRamp,
-    MotionProfile,
-    SCurve,
-    Trapezoid,
-)
-from gcodekit.emulate.planners import planner_settings
-from gcodekit.emulate.planners.base import PlannerMoves
 from gcodekit.errors import ConfigError
+from gcodekit.plan import planner_settings
+from gcodekit.plan.moves import PlannerMoves
+from gcodekit.plan.profile import BAAMMotionProfile, MotionProfile
+from gcodekit.plan.shapes import ConstantVelocity, LinearRamp, SCurve, Trapezoid
 
 
 def make_moves(points, speeds) -> PlannerMoves:

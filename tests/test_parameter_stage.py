@@ -244,7 +244,7 @@ line_text = st.one_of(
 programs = st.lists(line_text, min_size=1, max_size=8)
 
 
-@settings(max_examples=300, deadline=3000)
+@settings(max_examples=300, deadline=None)
 @given(program=programs)
 def test_random_programs_in_lenient_mode_never_raise(program):
     lines = [SourceLine(text, n, "r.ngc") for n, text in enumerate(program, 1)]
@@ -277,7 +277,7 @@ def code_part(text: str) -> str:
     return "".join(code)
 
 
-@settings(max_examples=300, deadline=3000)
+@settings(max_examples=300, deadline=None)
 @given(program=programs)
 def test_random_programs_in_strict_mode_raise_only_gcodekit_errors(program):
     lines = [SourceLine(text, n, "r.ngc") for n, text in enumerate(program, 1)]
@@ -287,7 +287,7 @@ def test_random_programs_in_strict_mode_raise_only_gcodekit_errors(program):
         assert exc.diagnostic is not None and exc.diagnostic.file == "r.ngc"
 
 
-@settings(max_examples=200, deadline=3000)
+@settings(max_examples=200, deadline=None)
 @given(
     values=st.lists(st.floats(-1e6, 1e6, allow_nan=False), min_size=1, max_size=5),
 )

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import gcodekit
-from gcodekit.emulate.planners import grbl, planner_settings, reprapfirmware
-from gcodekit.emulate.planners.base import firmware_moves
+from gcodekit.plan import grbl, planner_settings, reprapfirmware
+from gcodekit.plan.moves import firmware_moves
 
 GRBL = grbl.GrblConfig(max_rate_x=6000.0, max_rate_y=6000.0, max_rate_z=600.0,
                        acceleration_x=100.0, acceleration_y=100.0, acceleration_z=50.0)

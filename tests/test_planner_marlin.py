@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 import gcodekit
-from gcodekit.emulate.planners import planner_settings
-from gcodekit.emulate.planners import grbl, marlin
-from gcodekit.emulate.planners.base import firmware_moves
-from gcodekit.emulate.planners.base import speed_factor as _speed_factor
+from gcodekit.plan import planner_settings
+from gcodekit.plan import lookahead, marlin
+from gcodekit.plan.moves import firmware_moves
+from gcodekit.plan.moves import speed_factor as _speed_factor
 from gcodekit.parse.table import NAME_ID
 
 CASES = Path(__file__).parent / "golden" / "klipper" / "cases"  # cube20_marlin2.gcode lives there
@@ -439,7 +439,7 @@ G1 X15 Y12 Z2 F600
 @pytest.mark.parametrize("classic_jerk", [True, False], ids=["classic_jerk", "junction_deviation"])
 def test_vectorized_plan_matches_the_oracle(classic_jerk, block, monkeypatch):
     monkeypatch.setattr(marlin, "BLOCK", block)  # element-wise steps run block by block
-    monkeypatch.setattr(grbl, "BLOCK", block)
+    monkeypatch.setattr(lookahead, "BLOCK", block)
     config = marlin.MarlinConfig(classic_jerk=classic_jerk)
     op = gcodekit.gcode_to_operation(ORACLE_PROGRAM, "marlin", plan=False)
     moves, result = marlin.plan(op, config)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import check_choice
+from ..errors import ConfigError, check_choice
 
 SHAPES = ("rectangle", "ellipse", "stadium")
 
@@ -58,9 +58,9 @@ class Bead:
     def __post_init__(self):
         check_choice("shape", self.shape, SHAPES)
         if not (self.width > 0 and self.height > 0):
-            raise ValueError(f"bead width and height must be positive, not {self.width} x {self.height}")
+            raise ConfigError(f"bead width and height must be positive, not {self.width} x {self.height}")
         if self.shape == "stadium" and self.width < self.height:
-            raise ValueError(f"a stadium bead needs width >= height, not {self.width} < {self.height}")
+            raise ConfigError(f"a stadium bead needs width >= height, not {self.width} < {self.height}")
 
     @property
     def area(self) -> float:

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..emulate.arcs import waypoint_arc_points
+from ..errors import ConfigError
 from .bead import Bead
 
 if TYPE_CHECKING:
@@ -89,7 +90,7 @@ class AdditivePart:
             raise ValueError(f"{operation.file}: an AdditivePart needs an emulated operation (use gcode_to_operation)")
         normal = np.asarray(layer_normal, float)
         if normal.shape != (3,) or not np.linalg.norm(normal) > 0:
-            raise ValueError(f"layer_normal must be a non-zero 3-vector, not {layer_normal!r}")
+            raise ConfigError(f"layer_normal must be a non-zero 3-vector, not {layer_normal!r}")
         self.operation = operation
         self.bead = bead
         self.layer_normal = normal / np.linalg.norm(normal)

@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 
+from ..errors import ConfigError, MissingDependencyError
+
 if TYPE_CHECKING:
     import pyvista as pv
 
@@ -23,7 +25,7 @@ def import_pyvista():
     try:
         import pyvista
     except ImportError as exc:  # pragma: no cover - depends on the installation
-        raise ImportError("VTK export and 3D pictures need PyVista: pip install 'gcodekit[viz]'") from exc
+        raise MissingDependencyError("VTK export and 3D pictures need PyVista: pip install 'gcodekit[viz]'") from exc
     return pyvista
 
 
@@ -112,7 +114,7 @@ class VTKExporter:
         """
         path = Path(path)
         if path.suffix.lower() not in (".vtk", ".vtp"):
-            raise ValueError(f"{path}: choose a .vtk or .vtp file name")
+            raise ConfigError(f"{path}: choose a .vtk or .vtp file name")
         mesh = VTKExporter.additive_part_to_polydata(part, custom_scalars)
         if path.suffix.lower() == ".vtp":
             mesh.save(path, compression=compression)

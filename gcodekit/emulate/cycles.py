@@ -49,6 +49,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..limits import MotionBudget
 from ..parse.table import CYCLE_NAMES, MOTION_LINEAR, MOTION_RAPID
 from .arcs import PLANE_NAMES, PLANES
 
@@ -105,18 +106,22 @@ class CycleState:
 
 def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray,
               to_machine: Callable[[np.ndarray], np.ndarray], scale: np.ndarray, plane: int, incremental: bool,
-              dwell_unit: float, same_mode: bool = True) -> CycleMoves:
+              dwell_unit: float, same_mode: bool = True, budget: MotionBudget | None = None) -> CycleMoves:
     """Moves of one canned-cycle block (``params`` as written, in program units).
 
     The cycle works in program coordinates (mm) from ``program``, the
     current point; ``to_machine`` places each of its points on the machine.
     ``same_mode`` says the block continues the cycle mode in force (rs274's
     ``motion_mode == motion``), so that missing words keep their old values.
+    ``budget``, when given, is checked against the most moves the block can
+    make before any is made (L repeats times pecks can run into billions).
 
     Raises
     ------
     ValueError
         With the interpreter's reason (no R or Z in force, Q not positive, ...).
+    TooManyMotions
+        The block would make more moves than ``budget`` has room for.
     """
     if name:
         cycle.name = name
@@ -153,6 +158,8 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
         raise ValueError(f"R less than {letter.lower()} in cycle in {PLANE_NAMES[plane]} plane")
     if cycle.name in ("cycle_peck", "cycle_chip_break") and not (cycle.q and cycle.q > 0):
         raise ValueError("G73/G83 need a positive Q")
+    if budget is not None:
+        budget.check(repeats * _most_moves_per_hole(cycle, r, bottom) + 1)
     clear = r if cycle.retract_to_r or old < r else old
     below_r = old < r
     steps: list[Step] = []
@@ -221,6 +228,14 @@ def _check_new_mode_words(name: str, params: dict, plane: int) -> None:
         for word in ("IJK"[a], "IJK"[b], "IJK"[axis]):
             if word not in params:
                 raise ValueError(f"{word} word missing with g87")
+
+
+def _most_moves_per_hole(cycle: CycleState, r: float, bottom: float) -> float:
+    """An upper bound of the moves one hole takes: over it, to R, then the drilling (a
+    peck cycle up to three moves per peck)."""
+    if cycle.name in ("cycle_peck", "cycle_chip_break"):
+        return 3 * (max(r - bottom, 0.0) / cycle.q + 1) + 4
+    return 10
 
 
 def _back_bore_words(cycle: CycleState, params: dict, plane: int, scale: np.ndarray) -> None:

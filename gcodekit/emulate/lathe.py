@@ -32,6 +32,7 @@ import re
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
+from ..limits import MotionBudget
 from ..parse.table import PROFILE_TAG
 
 TOLERANCE = 1e-6  # LinuxCNC's g7x tolerance
@@ -582,7 +583,8 @@ def build_profile(start: complex, blocks: list[dict]) -> list[_Segment]:
     return out
 
 
-def finish(segments: list[_Segment], point: complex, d: float, e: float, passes: float) -> list[Move]:
+def finish(segments: list[_Segment], point: complex, d: float, e: float, passes: float, *,
+           budget: MotionBudget | None = None) -> list[Move]:
     """G70: ``passes`` finishing passes from distance ``d`` down to ``e``."""
     base = _Profile([s.copy() for s in segments])
     base.segments[0].start = point
@@ -601,6 +603,8 @@ def finish(segments: list[_Segment], point: complex, d: float, e: float, passes:
     moves: list[Move] = []
     out = _Sink(moves, base.state)
     count = int(passes)
+    if budget is not None:
+        budget.check(count * (len(base.segments) + 2))
     for k in range(count, 0, -1):
         path = base.copy()
         path.add_distance((k - 1) * (d - e) / passes + e)
@@ -612,8 +616,12 @@ def finish(segments: list[_Segment], point: complex, d: float, e: float, passes:
 
 
 def rough(segments: list[_Segment], point: complex, *, turn: bool, subcycle: int, d: float, i: float,
-          r: float, u: float = 0.0, w: float = 0.0) -> list[Move]:
-    """G71 (``turn`` False) or G72 (True): roughing passes ``i`` apart leaving ``d``."""
+          r: float, u: float = 0.0, w: float = 0.0, budget: MotionBudget | None = None) -> list[Move]:
+    """G71 (``turn`` False) or G72 (True): roughing passes ``i`` apart leaving ``d``.
+
+    ``budget``, when given, must have room for the most moves the passes can
+    make: each pass crosses every segment at most once.
+    """
     p = _Profile([s.copy() for s in segments])
     p.segments[0].start = point
     if turn:
@@ -627,6 +635,9 @@ def rough(segments: list[_Segment], point: complex, *, turn: bool, subcycle: int
     moves: list[Move] = []
     out = _Sink(moves, p.state)
     p.delta = max(i, 2 * TOLERANCE)
+    if budget is not None:
+        heights = [v for seg in p.segments for v in (seg.start.imag, seg.end.imag)]
+        budget.check(((max(heights) - min(heights)) / p.delta + 2) * (len(p.segments) + 4))
     p.escape = r * (1 + 1j)
     first, last = p.segments[0], p.segments[-1]
     out.rapid(first.start)
@@ -691,13 +702,15 @@ class LatheCycle(NamedTuple):
     profile_end: complex
 
 
-def run_lathe_cycle(block: CycleBlock) -> LatheCycle:
+def run_lathe_cycle(block: CycleBlock, budget: MotionBudget | None = None) -> LatheCycle:
     """The cycle point, the cycle's moves and where its profile ends.
 
     Raises
     ------
     LatheCycleError
         With rs274's message.
+    TooManyMotions
+        The passes would make more moves than ``budget`` has room for.
     """
     cycle, sub = LATHE_CYCLES[block.name]
     label = f"G{cycle}.{sub}"
@@ -725,10 +738,10 @@ def run_lathe_cycle(block: CycleBlock) -> LatheCycle:
         raise LatheCycleError("G7X error: I must be greater than zero.")
     d, e = p.get("D", 0.0) * k, p.get("E", 0.0) * k
     if cycle == 70:
-        return LatheCycle(point, finish(segments, point, d, e, p.get("P", 1.0)), end)
+        return LatheCycle(point, finish(segments, point, d, e, p.get("P", 1.0), budget=budget), end)
     u = p.get("U", 0.0) * k / (2.0 if block.diameter else 1.0)
     return LatheCycle(point, rough(segments, point, turn=cycle == 72, subcycle=sub, d=d, i=i,
-                                   r=p.get("R", 0.5) * k, u=u, w=p.get("W", 0.0) * k), end)
+                                   r=p.get("R", 0.5) * k, u=u, w=p.get("W", 0.0) * k, budget=budget), end)
 
 
 def _read_profile(block: CycleBlock, start: complex) -> list[dict]:

@@ -19,6 +19,7 @@ import dataclasses
 import numpy as np
 
 from ..errors import Diagnostics
+from ..limits import MAX_MOTIONS, MotionBudget, TooManyMotions
 from ..parse.commands import Kind
 from ..parse.split import MOTIONS
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, MOTION_THREAD, NAME_ID,
@@ -86,12 +87,18 @@ class Machine:
         RS274NGC block rules (F in any block; unknown axis letters refused).
     polar_incremental_only : bool
         GER's G16 rules: polar moves only in G91, program zero fixed meanwhile.
+    max_motions : int, default: :data:`gcodekit.limits.MAX_MOTIONS`
+        The waypoints the program may make (one per block, plus the moves
+        cycles and threads expand into); at the limit the machine stops with
+        an error naming the line (see :mod:`gcodekit.limits`).
     """
 
     def __init__(self, config: MachineConfig, diagnostics: Diagnostics | None = None, *,
                  rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = "",
-                 rs274_blocks: bool = False, polar_incremental_only: bool = False):
+                 rs274_blocks: bool = False, polar_incremental_only: bool = False, max_motions: int = MAX_MOTIONS):
         self.config = config
+        self.budget = MotionBudget(max_motions)
+        self.out_of_budget = False  # stopped at max_motions: the rest of the program is not run
         self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
         self.rapid_is_feed = config.rapid_is_feed if config.rapid_is_feed is not None else rapid_is_feed
         # RS274NGC block rules: an F word sets the feed whatever else the block
@@ -175,6 +182,8 @@ class Machine:
         """
         table = self._part_frame(self._radius_words(table))
         n = len(table)
+        stop = 0 if self.out_of_budget else min(n, self.budget.room)  # each block makes a waypoint
+        self.budget.spend(stop)
         out = {k: np.empty(n) for k in FLOAT_COLUMNS}
         out.update({k: np.empty(n, dtype) for k, (dtype, _) in SMALL_COLUMNS.items()})
         special = np.isin(table.name, self.modal.special_ids) | (table.letter == ord("T"))
@@ -192,7 +201,7 @@ class Machine:
         extra: list[tuple[int, Waypoint]] = []
         cursor = 0
         for row in np.flatnonzero(special | probing).tolist():
-            if self.state.ended:
+            if self.state.ended or row >= stop:
                 break
             if row > cursor:
                 self._run_segment(table, cursor, row, out)
@@ -201,20 +210,37 @@ class Machine:
                 self._run_segment(table, row, row + 1, out)
                 self._after_probe(start)
             else:
-                extra += [(row, w) for w in self.modal.apply(table, row, out)]
+                try:
+                    passed = self.modal.apply(table, row, out)
+                    self.budget.spend(len(passed))
+                except TooManyMotions as exc:
+                    self._hold(row, row + 1, out)
+                    self._out_of_budget(int(table.line[row]), f"this block would make up to {exc}")
+                    passed = []
+                extra += [(row, w) for w in passed]
             cursor = row + 1
-        if cursor < n and not self.state.ended:
-            self._run_segment(table, cursor, n, out)
-            cursor = n
+        if cursor < stop and not self.state.ended:
+            self._run_segment(table, cursor, stop, out)
+            cursor = stop
+        if stop < n and not self.out_of_budget:
+            self._out_of_budget(int(table.line[stop]), f"the program makes more than max_motions="
+                                f"{self.budget.limit:,} motions")
         self.modal.cycle_mode_open = bool(n) and int(table.motion[-1]) == MOTION_CYCLE
         setting = np.flatnonzero((table.letter == ord("G")) & np.isin(table.name, self._motion_mode_ids))
         if setting.size:  # the motion mode in force (#<_motion_mode>)
             self.state.motion_code = int(table.number[setting[-1]])
         if cursor < n:
             self._hold(cursor, n, out)
-            self.warn_once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
+            if not self.out_of_budget:
+                self.warn_once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
         return _constants_as_views(_with_extra_waypoints(out, extra, n))
 
+    def _out_of_budget(self, line: int, problem: str) -> None:
+        """Stop the machine at the motion limit: the rest of the program is not run."""
+        self.diagnostics.report(line, 1, f"{problem}; the rest of the program is not run (raise max_motions "
+                                "if it is meant to be this long)", kind="limit")
+        self.out_of_budget = True
+        self.state.ended = True
     def _after_probe(self, start: np.ndarray) -> None:
         """Where a probe move leaves the machine, as rs274 run standalone has it.
 

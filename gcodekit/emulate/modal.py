@@ -81,6 +81,9 @@ class Waypoint:
     values: dict[str, float] = field(default_factory=dict)
 
 
+#: Largest tool number: the tool column is 32-bit, as LinuxCNC's tool numbers are C ints.
+MAX_TOOL = 2**31 - 1
+
 #: Canned cycles rs274 refuses with the spindle stopped (with its spelling of each code)
 _SPINDLE_CYCLES = {"cycle_tap_left": "G74", "cycle_tap": "G84", "cycle_bore_stop": "g86", "cycle_back_bore": "g87",
                    "cycle_bore_manual": "g88"}
@@ -227,11 +230,17 @@ class ModalHandler:
             self._end_program()
         elif name in ("tool_length_offset", "tool_length_offset_add"):
             number = params.get("H", s.tool)
-            offset = self.machine.tools.offset(int(number))
-            # rs274 re-reads its position after a tool change, so a G43 in the
-            # M6 block keeps the program position; elsewhere the machine stays.
-            self._change_tool_offset(offset if name == "tool_length_offset" else self._tool_offset_held() + offset,
-                                     keep_program_position=line == self._tool_change_line)
+            if 0 <= number <= MAX_TOOL:
+                if not self.machine.config.tool_table:
+                    self._check_tool(int(number), line)
+                offset = self.machine.tools.offset(int(number))
+                # rs274 re-reads its position after a tool change, so a G43 in the
+                # M6 block keeps the program position; elsewhere the machine stays.
+                self._change_tool_offset(offset if name == "tool_length_offset" else self._tool_offset_held() + offset,
+                                         keep_program_position=line == self._tool_change_line)
+            else:
+                self.machine.diagnostics.report(line, 1, f"H word {number:.0f} out of range (0 to {MAX_TOOL})",
+                                                kind="machine")  # rs274: a negative H is refused too
         elif name == "tool_length_offset_dynamic":  # G43.1: the axes it names; the others keep their offsets
             scale, held = s.scale(), self._tool_offset_held()
             self._change_tool_offset([params[letter] * scale[ax] if letter in params else held[ax]
@@ -288,7 +297,7 @@ class ModalHandler:
             steps, end = run_cycle(name if name in CYCLES else "", params, s.cycle, program=s.program_position(),
                                    to_machine=s.to_machine, scale=s.scale(), plane=s.plane,
                                    incremental=s.incremental, dwell_unit=unit,
-                                   same_mode=same_mode or not self.machine.rs274_blocks)
+                                   same_mode=same_mode or not self.machine.rs274_blocks, budget=self.machine.budget)
         except ValueError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
             return MOTION_NONE, []
@@ -336,7 +345,7 @@ class ModalHandler:
         moves = threading_moves((program[0], program[2]), end[2], p=params["P"] * k, i=params["I"] * k / halve,
                                 j=params["J"] * k / halve, k=params["K"] * k / halve, q=params.get("Q", 0.0),
                                 h=int(params.get("H", 0)), r=params.get("R", 1.0), e=params.get("E", 0.0) * k,
-                                taper=int(params.get("L", 0)))
+                                taper=int(params.get("L", 0)), budget=self.machine.budget)
         steps = []
         for kind, x, z, pitch in moves + [("rapid", end[0], end[2], None)]:
             point = program.copy()
@@ -387,7 +396,7 @@ class ModalHandler:
         block = CycleBlock(name, params, profile_of(comment), complex(program[2], program[0]), s.units,
                            s.incremental, s.arc_incremental, s.diameter, s.plane, s.compensating)
         try:
-            point, moves, profile_end = run_lathe_cycle(block)
+            point, moves, profile_end = run_lathe_cycle(block, self.machine.budget)
         except LatheCycleError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
             return MOTION_NONE, []
@@ -641,8 +650,12 @@ class ModalHandler:
 
     def _tool(self, t: CommandTable, row: int, params: dict) -> None:
         s = self.state
+        number = int(round(t.number[row] / 10)) if chr(int(t.letter[row])) == "T" else int(params.get("T", 0))
+        if not 0 <= number <= MAX_TOOL:  # rs274's message for a negative one (interp_read.cc read_t)
+            message = "Negative tool id used" if number < 0 else f"Tool number {number} out of range (at most {MAX_TOOL})"
+            self.machine.diagnostics.report(int(t.line[row]), 1, message, kind="machine")
+            return
         if chr(int(t.letter[row])) == "T":
-            number = int(round(t.number[row] / 10))
             self._check_tool(number, int(t.line[row]))
             if self.machine.config.tool_change_on == "T":
                 s.tool = number
@@ -658,10 +671,16 @@ class ModalHandler:
                     s.keep_program_position(s.canon_point - s.frame - s.g92)
 
     def _check_tool(self, number: int, line: int) -> None:
-        """With a tool table, selecting a tool it lacks is LinuxCNC's error (T0, no tool, is fine)."""
-        if number and self.machine.config.tool_table and number not in self.machine.tools:
+        """With a tool table, selecting a tool it lacks is LinuxCNC's error (T0, no tool, is fine);
+        without one, a mill's tools have no length or diameter, which is said once."""
+        config = self.machine.config
+        if number and config.tool_table and number not in self.machine.tools:
             self.machine.diagnostics.report(line, 1, f"Requested tool {number} not found in the tool table",
                                             kind="machine")
+        elif number and not config.tool_table and config.process != "additive":
+            self.machine.warn_once("no tool table", line, f"no tool table: tool {number} (and every other) is taken "
+                                   "to have no length or diameter; LinuxCNC refuses a tool its table lacks (give "
+                                   "the machine a tool_table)")
 
     def _set_kinematic_position(self, text: str) -> None:
         """Klipper's SET_KINEMATIC_POSITION X=.. Y=.. Z=..: the toolhead is declared there."""

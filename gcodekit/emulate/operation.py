@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import Diagnostics
+from ..limits import MAX_MOTIONS
 from ..parse.commands import Command, Kind
 from ..parse.table import MOTION_NAMES, NAME_ID, CommandTable
 from ..syntax.flavor import code_label
@@ -134,6 +135,8 @@ class Operation:
     flavor : Flavor
     machine : MachineConfig, optional
     diagnostics : Diagnostics
+    max_motions : int, default: :data:`gcodekit.limits.MAX_MOTIONS`
+        The moves a planner may cut the program's arcs into (see :mod:`gcodekit.limits`).
     """
 
     process_data_class: type[ProcessData] = ProcessData
@@ -141,8 +144,9 @@ class Operation:
     def __init__(self, commands: CommandTable, waypoints: dict[str, np.ndarray] | None = None, *,
                  file: str = "<string>", flavor: "Flavor | None" = None,
                  machine: "MachineConfig | None" = None, diagnostics: Diagnostics | None = None,
-                 n_lines: int = 0):
+                 n_lines: int = 0, max_motions: int = MAX_MOTIONS):
         self.table = commands
+        self.max_motions = max_motions
         self.waypoints = waypoints
         self.file = file
         self.flavor = flavor
@@ -302,7 +306,7 @@ class Operation:
             data[key] = w[key]
         data["motion"] = pd.Categorical.from_codes(w["motion"], categories=["none", *MOTION_NAMES[1:]])
         if getattr(self, "plan", None) is not None:
-            from .planners import waypoint_speeds
+            from ..plan import waypoint_speeds
 
             data.update(waypoint_speeds(self))
         data["elapsed_time"] = self.elapsed_time()
@@ -368,7 +372,7 @@ class Operation:
         frame["time"] = w["time"][moved]
         frame["t_end"] = self.elapsed_time()[moved]
         if getattr(self, "plan", None) is not None:  # planned by the machine's firmware model
-            from .planners import waypoint_speeds
+            from ..plan import waypoint_speeds
 
             for key, values in waypoint_speeds(self).items():
                 if key != "accel":

@@ -39,6 +39,7 @@ True
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING, Callable
 
 if TYPE_CHECKING:
@@ -146,12 +147,14 @@ _MACHINE_READERS: dict[int | str, Callable[["Machine"], float]] = {
 }
 
 
+@functools.lru_cache(maxsize=4096)  # asked for every parameter read of a program's loops
 def is_state_parameter(key: int | str) -> bool:
     """Whether ``key`` (a number, or a normalized name) reports the machine's state or configuration."""
     return (key in _READERS or key in _MACHINE_READERS or is_stored_parameter(key)
             or (isinstance(key, str) and key.startswith("_ini[")))
 
 
+@functools.lru_cache(maxsize=4096)
 def is_stored_parameter(key: int | str) -> bool:
     """Whether ``key`` is a stored position or offset a program may write (``#5221 = 1``)."""
     return key == 5210 or _stored_slot(key) is not None

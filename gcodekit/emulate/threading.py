@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import math
 
+from ..limits import MotionBudget
+
 
 class ThreadingError(ValueError):
     """A G76 block the cycle refuses; the message is rs274's."""
@@ -52,7 +54,7 @@ def check_words(words: dict[str, float], compensating: bool) -> None:
 
 def threading_moves(start: tuple[float, float], end_z: float, *, p: float, i: float, j: float, k: float,
                     q: float = 0.0, h: int = 0, r: float = 1.0, e: float = 0.0,
-                    taper: int = 0) -> list[tuple[str, float, float, float | None]]:
+                    taper: int = 0, budget: MotionBudget | None = None) -> list[tuple[str, float, float, float | None]]:
     """The moves of one G76 cycle: (``"rapid"`` or ``"feed"``, X, Z, pitch of a spindle-synchronized feed).
 
     ``start`` is the (X, Z) where the cycle starts; ``p`` the pitch, ``i``
@@ -61,7 +63,8 @@ def threading_moves(start: tuple[float, float], end_z: float, *, p: float, i: fl
     angle (degrees), ``h`` spring passes, ``r`` the depth degression, ``e``
     the taper length along Z and ``taper`` the L flags (1 entry, 2 exit).
     Lengths in mm, X a radius.  The final rapid to the block's end point is
-    not included.
+    not included.  ``budget``, when given, must have room for every pass
+    (:class:`~gcodekit.limits.TooManyMotions` otherwise, before any is made).
     """
     safe_x, start_z = start
     boring = i > 0.0
@@ -78,6 +81,11 @@ def threading_moves(start: tuple[float, float], end_z: float, *, p: float, i: fl
     degression = r if r >= 1.0 else 1.0
     entry, exit_ = bool(taper & 1), bool(taper & 2)
     target_z = end_z + full_threadheight * math.tan(angle)
+
+    if budget is not None:  # pass n cuts to i + j * n**(1/r): (k/j)**r passes, then the spring passes
+        exponent = degression * math.log(max(full_threadheight / cut_increment, 1.0))
+        passes = math.inf if exponent > 700.0 else math.exp(exponent)
+        budget.check(6 * (passes + max(h, 0) + 2))
 
     def x_at(depth: float) -> float:
         return safe_x + depth if boring else safe_x - depth

@@ -50,6 +50,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Iterable, Iterator, Sequence
 
 from gcodekit.errors import Diagnostics, GcodeError, GcodeLimitError, did_you_mean
+from gcodekit.limits import MAX_ITERATIONS, MAX_MOTIONS
 from gcodekit.preprocess.expressions import Node, compact, evaluate, expression_error, parse_value
 from gcodekit.parse.table import PROFILE_TAG
 from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, format_number
@@ -62,8 +63,6 @@ if TYPE_CHECKING:
 #: ``INTERP_SUB_ROUTINE_LEVELS`` = 10 call frames, frame 0 being the main
 #: program, and refuses the call that would open frame 10.
 MAX_CALL_DEPTH = 9
-#: Most loop iterations (jumps back) in one run, over all loops together.
-MAX_ITERATIONS = 1_000_000
 #: Most lines (O-words included) executed in one run; bounds the work of
 #: calls that fan out without looping.
 MAX_LINES = 5_000_000
@@ -84,6 +83,8 @@ _MAYBE_LATHE_CYCLE = re.compile(r"[gG][ \t0]*7[ \t]*[012]")
 _LATHE_CYCLES = frozenset((70.0, 71.0, 71.1, 71.2, 72.0, 72.1, 72.2))
 # LinuxCNC subroutine file names: lower-case letters, digits, '-' and '_'.
 _FILE_NAME = re.compile(r"[a-z0-9_-]+")
+# A called name that reaches for a path: refused, so a program cannot read files elsewhere.
+_PATH_PARTS = re.compile(r"[/\\]|\.\.")
 _CONDITIONS = ("if", "elseif", "while", "repeat")
 _CLOSERS = {"endsub": "sub", "endif": "if", "endwhile": "while", "endrepeat": "repeat"}
 
@@ -159,9 +160,11 @@ class ControlFlowStage:
     sees the values from before its assignments).  O-word lines, ``M98``
     and ``M99`` words and lines left empty are not emitted; a line keeps
     the file and line number it was written on.  See the module docstring
-    for the statements and :data:`MAX_ITERATIONS`, :data:`MAX_CALL_DEPTH`
-    and :data:`MAX_LINES` for the limits.  A flavor without ``parameters``
-    passes lines through.
+    for the statements, :data:`MAX_CALL_DEPTH` and :data:`MAX_LINES`, and
+    :mod:`gcodekit.limits` for ``max_iterations`` (every loop iteration and
+    M98 repeat counts; a repeat count larger than what is left is refused
+    before the first repeat) and ``max_motions`` (the blocks emitted).  A
+    flavor without ``parameters`` passes lines through.
 
     Parameters
     ----------
@@ -173,9 +176,10 @@ class ControlFlowStage:
     fanuc_subs : bool, default: True
         Fanuc-style subprograms run (M98/M99); False refuses them, as
         rs274 does under ``[RS274NGC] DISABLE_FANUC_STYLE_SUB``.
-    max_iterations, max_call_depth, max_lines : int
-        Limits; default :data:`MAX_ITERATIONS`, :data:`MAX_CALL_DEPTH`,
-        :data:`MAX_LINES`.
+    max_iterations, max_call_depth, max_lines, max_motions : int
+        Limits; default :data:`~gcodekit.limits.MAX_ITERATIONS`,
+        :data:`MAX_CALL_DEPTH`, :data:`MAX_LINES`,
+        :data:`~gcodekit.limits.MAX_MOTIONS`.
 
     Examples
     --------
@@ -194,7 +198,7 @@ class ControlFlowStage:
     def __init__(self, flavor: Flavor, store: ParameterStore | None = None, *,
                  search_path: Sequence[str | os.PathLike] = (), fanuc_subs: bool = True,
                  max_iterations: int = MAX_ITERATIONS, max_call_depth: int = MAX_CALL_DEPTH,
-                 max_lines: int = MAX_LINES):
+                 max_lines: int = MAX_LINES, max_motions: int = MAX_MOTIONS):
         self.flavor = flavor
         self.parameters = ParameterStage(flavor, store)
         self.store = self.parameters.store
@@ -203,6 +207,7 @@ class ControlFlowStage:
         self.max_iterations = max_iterations
         self.max_call_depth = max_call_depth
         self.max_lines = max_lines
+        self.max_motions = max_motions
 
     def process(self, lines: Iterable[SourceLine], diagnostics: Diagnostics) -> Iterator[SourceLine]:
         """Yield the executed lines, substituted, in execution order."""
@@ -226,6 +231,7 @@ class _Run:
         self.directories: list[Path] = []
         self.iterations = 0
         self.executed = 0
+        self.emitted = 0  # blocks passed on, against max_motions
         self.frames: list[_Frame] = []
         self.code = _Code("", [])
         self.pc = 0
@@ -262,7 +268,12 @@ class _Run:
                     self._oword(st)
                 else:
                     self.pc += 1
-                    yield from self._plain(st)
+                    for out in self._plain(st):
+                        self.emitted += 1
+                        if self.emitted > self.stage.max_motions:
+                            self._limit(st, f"the program makes more than max_motions={self.stage.max_motions:,} "
+                                        "blocks; the rest is not run")
+                        yield out
         except _Stop:
             return
 
@@ -315,6 +326,7 @@ class _Run:
         elif k == "repeat":
             count = self._value(st, st.args[0]) if not st.bad else 0.0
             count = 0 if count is None else math.floor(count + 0.5)  # LinuxCNC round_to_int
+            self._check_repeats(st, count, f"{st.name} [{count}]")
             if count > 0:
                 self.counters[self.pc] = count - 1
                 self.pc += 1
@@ -369,10 +381,17 @@ class _Run:
         value = self._value(st, st.args[0])
         return value is not None and value != 0.0
 
+    def _check_repeats(self, st: OWord | SourceLine, count: int, what: str) -> None:
+        """Refuse ``count`` repeats up front when they would pass ``max_iterations``."""
+        left = self.stage.max_iterations - self.iterations
+        if count - 1 > left:
+            self._limit(st, f"{what}: {count - 1:,} repeats, more than the {max(left, 0):,} iterations left of "
+                        f"max_iterations={self.stage.max_iterations:,}")
+
     def _tick(self, st: OWord) -> None:
         self.iterations += 1
         if self.iterations > self.stage.max_iterations:
-            self._limit(st, f"more than {self.stage.max_iterations} loop iterations (the limit)")
+            self._limit(st, f"more than max_iterations={self.stage.max_iterations:,} loop iterations")
 
     def _limit(self, st: OWord | SourceLine, message: str) -> None:
         line, column = (st.line, st.column) if isinstance(st, OWord) else (st, 1)
@@ -441,12 +460,16 @@ class _Run:
         """The sub (or Fanuc program) ``label``, read from a file if need be."""
         if label not in table:
             name = label.strip("<>")
+            if _PATH_PARTS.search(name):
+                line, column = (st.line, st.column) if isinstance(st, OWord) else (st, 1)
+                self._report(line, column, f"o{label}: a subroutine is called by its name, not a path ('/', '\\' "
+                             "and '..' are not allowed); its file is looked up in the program's folder and the "
+                             "subroutine path")
+                return None
             if _FILE_NAME.fullmatch(name):
-                for directory in self.directories:
-                    path = directory / f"{name}.ngc"
-                    if str(path) not in self.loaded and path.is_file():
-                        self._load(path)
-                        break
+                path = self._subroutine_file(name, st)
+                if path is not None:
+                    self._load(path)
         if label in table:
             return table[label]
         calling = st.line.line if isinstance(st, OWord) else st.line
@@ -471,6 +494,21 @@ class _Run:
             called += f" (called on line {calling})"
         message = f"call of unknown {what} {called}: not in the program nor as {label.strip('<>')}.ngc in {where}{hint}"
         self._report(line, column, message)
+        return None
+
+    def _subroutine_file(self, name: str, st: OWord | SourceLine) -> Path | None:
+        """``name.ngc`` in the first search directory that has it, not loaded yet; a file that is
+        a link out of its directory is not followed (a program may not read files elsewhere)."""
+        for directory in self.directories:
+            path = directory / f"{name}.ngc"
+            if str(path) in self.loaded or not path.is_file():
+                continue
+            if not path.resolve().is_relative_to(directory.resolve()):
+                line, column = (st.line, st.column) if isinstance(st, OWord) else (st, 1)
+                self._report(line, column, f"{path} links to a file outside {directory}; not read",
+                             severity="warning")
+                continue
+            return path
         return None
 
     def _load(self, path: Path) -> None:
@@ -599,6 +637,7 @@ class _Run:
         repeats = math.floor(count + 0.5)
         if repeats <= 0:
             return
+        self._check_repeats(line, repeats, f"M98 L{repeats}")
         target = self._find(format_number(float(math.floor(p + 0.5))), self.programs, line)
         if target is not None:
             self._enter(line, target, None, fanuc=True, repeats=repeats)
@@ -624,7 +663,7 @@ class _Run:
     def _tick_line(self, line: SourceLine) -> None:
         self.iterations += 1
         if self.iterations > self.stage.max_iterations:
-            self._limit(line, f"more than {self.stage.max_iterations} loop iterations (the limit)")
+            self._limit(line, f"more than max_iterations={self.stage.max_iterations:,} loop iterations")
 
     # -- reading O-words -----------------------------------------------------
 

@@ -69,6 +69,7 @@ from gcodekit.errors import (
     GcodeMachineError,
     did_you_mean,
 )
+from gcodekit.limits import MAX_MOTIONS
 
 if TYPE_CHECKING:
     from gcodekit.preprocess import SourceLine
@@ -339,6 +340,8 @@ class WizardStage:
         :data:`DEFAULT_SETTINGS` and ``tools`` (tool number to diameter, mm).
     max_lines : int, default: :data:`MAX_LINES`
         Most lines one call may emit (a :class:`~gcodekit.errors.GcodeLimitError`).
+    max_motions : int, default: :data:`gcodekit.limits.MAX_MOTIONS`
+        Most lines all calls together may emit; the run stops there.
 
     Examples
     --------
@@ -354,11 +357,13 @@ class WizardStage:
     name = "wizards"
 
     def __init__(self, flavor: Flavor, registry: WizardRegistry | None = None, *,
-                 settings: Mapping[str, Any] | None = None, max_lines: int = MAX_LINES):
+                 settings: Mapping[str, Any] | None = None, max_lines: int = MAX_LINES,
+                 max_motions: int = MAX_MOTIONS):
         self.flavor = flavor
         self.registry = DEFAULT_REGISTRY if registry is None else registry
         self.settings = dict(settings or {})
         self.max_lines = int(max_lines)
+        self.max_motions = max_motions
 
     def process(self, lines: Iterable[SourceLine], diagnostics: Diagnostics) -> Iterator[SourceLine]:
         """Yield the lines with every wizard call expanded."""
@@ -380,6 +385,7 @@ class _Run:
         self.distance = "absolute"
         self.tool: int | None = None
         self.in_comment = False
+        self.emitted = 0  # lines all calls emitted, against max_motions
 
     def run(self, lines: Iterable[SourceLine]) -> Iterator[SourceLine]:
         from gcodekit.preprocess import SourceLine
@@ -391,6 +397,12 @@ class _Run:
                 yield sl
                 continue
             texts = self._expand(sl, start)
+            self.emitted += len(texts)
+            if self.emitted > self.stage.max_motions:
+                self.diagnostics.report(sl.line, start + 1, f"wizard calls emit more than max_motions="
+                                        f"{self.stage.max_motions:,} lines; the rest is not run", sl.text,
+                                        kind="limit", file=sl.file)
+                return
             # A '(' after the arguments opens a comment that goes on past the
             # call: re-open it after the emitted lines, for the reader.
             opened, self.in_comment = self.in_comment, False

@@ -1,7 +1,7 @@
 """Read stage: program text to :class:`Blocks` of words and comments.
 
-Files may be plain or gzip-compressed; strings and preprocessed line lists
-are read the same way.  Large inputs are read in chunks of whole lines so
+Files may be plain or compressed (see :mod:`.source` for the containers
+and encodings); strings and preprocessed line lists are read the same way.  Large inputs are read in chunks of whole lines so
 later stages can run chunk by chunk with bounded memory.
 
 Examples
@@ -14,11 +14,9 @@ Examples
 
 from __future__ import annotations
 
-import gzip
-import io
 import os
 from pathlib import Path
-from typing import IO, Iterable, Iterator, Union
+from typing import Iterable, Iterator
 
 import numpy as np
 
@@ -26,59 +24,14 @@ from ..errors import Diagnostics
 from ..syntax import Flavor, load_flavor
 from .blocks import Block, Blocks, Word
 from .scan import fast_path_possible, scan
+from .source import MAX_LINE_LENGTH, iter_lines, open_program
 from .tokenize import LineTokenizer, RawBlock
 
 __all__ = ["Block", "Blocks", "Word", "read_text", "read_file", "iter_blocks", "iter_lines",
-           "open_program", "read_source_lines", "MAX_LINE_LENGTH"]
+           "open_program", "read_source_lines", "iter_source_blocks", "MAX_LINE_LENGTH"]
 
-Source = Union[str, os.PathLike, bytes]
-CHUNK_BYTES = 256 << 10  # small chunks keep the per-chunk arrays (about 60 bytes per input byte) small
-#: Longer lines are reported and skipped: no real controller accepts them,
-#: and a binary file without newlines must not be read as one huge block.
-MAX_LINE_LENGTH = 65536
-
-
-def open_program(path: str | os.PathLike) -> IO[bytes]:
-    """Open a program for reading bytes, decompressing gzip by its magic number."""
-    f = open(path, "rb")
-    if f.peek(2)[:2] == b"\x1f\x8b":
-        return gzip.GzipFile(fileobj=f)  # type: ignore[return-value]
-    return f
-
-
-def _byte_chunks(stream: IO[bytes], size: int) -> Iterator[bytes]:
-    """Chunks of whole lines, each ending with a newline."""
-    rest = b""
-    while True:
-        data = stream.read(size)
-        if not data:
-            break
-        data = rest + data
-        cut = data.rfind(b"\n") + 1
-        if cut == 0:
-            rest = data
-            if len(rest) > MAX_LINE_LENGTH * 4:
-                yield rest + b"\n"
-                rest = b""
-            continue
-        rest = data[cut:]
-        yield data[:cut]
-    if rest:
-        yield rest + b"\n"
-
-
-def iter_lines(source: Source) -> Iterator[bytes]:
-    """Byte chunks of whole lines from a path, text or bytes."""
-    if isinstance(source, (str, bytes)) and not _is_path(source):
-        data = source.encode("utf-8", "surrogateescape") if isinstance(source, str) else source
-        yield from _byte_chunks(io.BytesIO(data), CHUNK_BYTES)
-        return
-    with open_program(source) as f:  # type: ignore[arg-type]
-        yield from _byte_chunks(f, CHUNK_BYTES)
-
-
-def _is_path(source: object) -> bool:
-    return isinstance(source, os.PathLike)
+#: Preprocessed lines read into one chunk of blocks (see :func:`iter_source_blocks`)
+CHUNK_LINES = 50_000
 
 
 def iter_blocks(
@@ -125,7 +78,7 @@ def _tokenize(tokenizer: LineTokenizer, line: bytes, number: int, diagnostics: D
 def _read_fast(
     data: bytes, first_line: int, flavor: Flavor, tokenizer: LineTokenizer, diagnostics: Diagnostics
 ) -> Blocks:
-    s = scan(data, flavor)
+    s = scan(data, flavor, MAX_LINE_LENGTH)
     n = s.n_lines
     ends = np.r_[s.line_start[1:] - 1, len(data) - 1]
     raw_lines: list[int] = []
@@ -196,7 +149,7 @@ def read_text(text: str, flavor: Flavor | str = "rs274ngc", *, file: str = "<str
               mode: str = "lenient") -> Blocks:
     """Read program text into :class:`Blocks` (diagnostics in ``blocks.diagnostics``)."""
     diagnostics = Diagnostics(file, mode)
-    blocks = Blocks.concat(list(iter_blocks(iter_lines(text), _resolve(flavor), diagnostics)))
+    blocks = Blocks.concat(list(iter_blocks(iter_lines(text, diagnostics), _resolve(flavor), diagnostics)))
     blocks.file = file
     blocks.diagnostics = diagnostics  # type: ignore[attr-defined]
     return blocks
@@ -205,7 +158,7 @@ def read_text(text: str, flavor: Flavor | str = "rs274ngc", *, file: str = "<str
 def read_file(path: str | os.PathLike, flavor: Flavor | str = "rs274ngc", *, mode: str = "lenient") -> Blocks:
     """Read a plain or gzip program file into :class:`Blocks`."""
     diagnostics = Diagnostics(str(path), mode)
-    blocks = Blocks.concat(list(iter_blocks(iter_lines(Path(path)), _resolve(flavor), diagnostics)))
+    blocks = Blocks.concat(list(iter_blocks(iter_lines(Path(path), diagnostics), _resolve(flavor), diagnostics)))
     blocks.file = str(path)
     blocks.diagnostics = diagnostics  # type: ignore[attr-defined]
     return blocks
@@ -213,11 +166,27 @@ def read_file(path: str | os.PathLike, flavor: Flavor | str = "rs274ngc", *, mod
 
 def read_source_lines(lines: Iterable, flavor: Flavor, diagnostics: Diagnostics) -> Blocks:
     """Read preprocessed lines (objects with ``text`` and ``line``) one by one."""
+    return Blocks.concat(list(iter_source_blocks(lines, flavor, diagnostics, chunk_lines=None)))
+
+
+def iter_source_blocks(lines: Iterable, flavor: Flavor, diagnostics: Diagnostics, *,
+                       chunk_lines: int | None = CHUNK_LINES) -> Iterator[Blocks]:
+    """Read preprocessed lines into :class:`Blocks` of at most ``chunk_lines`` lines each.
+
+    A loop can emit millions of lines: reading them a chunk at a time lets
+    the later stages run on each chunk and drop it, so memory holds the
+    columns, not the lines.  At least one (possibly empty) chunk is yielded.
+    """
     tokenizer = LineTokenizer(flavor, diagnostics)
     raw: list[RawBlock] = []
+    count = 0
     for sl in lines:
         if len(sl.text) > MAX_LINE_LENGTH:
             diagnostics.report(sl.line, 1, f"line is longer than {MAX_LINE_LENGTH} characters; skipped")
-            continue
-        raw.extend(tokenizer.tokenize(sl.text, sl.line))
-    return Blocks.from_raw(diagnostics.file, raw)
+        else:
+            raw.extend(tokenizer.tokenize(sl.text, sl.line))
+        count += 1
+        if chunk_lines is not None and count >= chunk_lines:
+            yield Blocks.from_raw(diagnostics.file, raw)
+            raw, count = [], 0
+    yield Blocks.from_raw(diagnostics.file, raw)

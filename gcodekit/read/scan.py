@@ -43,6 +43,15 @@ def _byte_classes(flavor: Flavor) -> np.ndarray:
     return table
 
 
+def _string_code_keys(flavor: Flavor) -> np.ndarray:
+    """The flavor's string codes keyed as :func:`scan` keys words: letter * 10**6 + tenths."""
+    keys = []
+    for code in flavor.string_codes:
+        whole, _, tenth = code[1:].partition(".")
+        keys.append(ord(code[0].upper()) * 1_000_000 + int(whole) * 10 + int(tenth or 0))
+    return np.array(keys, np.int64)
+
+
 @dataclass
 class ScanResult:
     """Words and comments of the regular lines of one chunk.
@@ -68,8 +77,12 @@ def fast_path_possible(flavor: Flavor) -> bool:
     return not (flavor.statement_separators or flavor.multiline_comments)
 
 
-def scan(data: bytes, flavor: Flavor) -> ScanResult:
-    """Cut ``data`` (whole lines, ending with ``\\n``) into words and comments."""
+def scan(data: bytes, flavor: Flavor, max_line_length: int | None = None) -> ScanResult:
+    """Cut ``data`` (whole lines, ending with ``\\n``) into words and comments.
+
+    Lines longer than ``max_line_length`` are left irregular, for the
+    tokenizer to report.
+    """
     b = np.frombuffer(data, dtype=np.uint8)
     cls = _byte_classes(flavor)[b]
     nl = np.flatnonzero(cls == _NEWLINE)
@@ -103,6 +116,8 @@ def scan(data: bytes, flavor: Flavor) -> ScanResult:
     bad |= (c == _SIGN) & ~prev_letter  # a sign inside a number
     line_ok = np.ones(n_lines, dtype=bool)
     line_ok[cline[bad]] = False
+    if max_line_length is not None and n_lines:
+        line_ok &= np.diff(np.r_[line_start, nl[-1] + 1]) - 1 <= max_line_length
     del bad, prev_letter, prev_num
 
     # Segments start at each letter and each newline, so no word runs into
@@ -154,6 +169,9 @@ def scan(data: bytes, flavor: Flavor) -> ScanResult:
     code_letter = ob[starts] & 0xDF
     odd_code = ((code_letter == ord("G")) | (code_letter == ord("M"))) & ~((value >= 0) & (value < 10000))
     line_ok[token_line[odd_code]] = False  # the reference tokenizer reports it
+    if flavor.string_codes:  # the rest of an M23/M117 line is its argument, not words
+        codes = code_letter.astype(np.int64) * 1_000_000 + np.round(value * 10).astype(np.int64)
+        line_ok[token_line[np.isin(codes, _string_code_keys(flavor))]] = False
 
     keep_tok = line_ok[token_line]
     word_line = token_line[keep_tok]

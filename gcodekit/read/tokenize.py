@@ -17,6 +17,7 @@ from ..syntax.flavor import code_label
 
 _DIGITS = "0123456789"
 _SPACE = " \t\r\f\v"
+_NO_SPACE = str.maketrans("", "", _SPACE)  # removes the blanks a number may hold (spaces_in_numbers)
 #: No machine takes coordinates this large; longer numbers are typos or garbage.
 _LARGEST = 1e15
 #: Sinumerik 840D value assignment: an address or variable, an optional
@@ -189,7 +190,7 @@ class LineTokenizer:
             elif not (fl.spaces_in_numbers and c in _SPACE and digits + dot):
                 break
             j += 1
-        number = text[start:j].replace(" ", "").replace("\t", "")
+        number = text[start:j].translate(_NO_SPACE)
         if fl.block_split == "single" and letter not in "GM":
             if j < n and text[j] == '"':  # firmware string argument: P"MK3S"
                 end = text.find('"', j + 1)

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence
 
 from ..errors import GcodeError
+from ..limits import MAX_ITERATIONS, MAX_MOTIONS
 
 if TYPE_CHECKING:
     import multiprocessing.context
@@ -46,6 +47,7 @@ class ReportOptions:
     strict : bool, default: False
         A program with an error gets an error page naming its line, instead
         of a report listing the error among its diagnostics.
+    max_motions, max_iterations : as for :func:`gcodekit.gcode_to_operation`
     """
 
     machine: str | None = None
@@ -54,6 +56,8 @@ class ReportOptions:
     notebook: bool = False
     notebook_html: bool = False
     strict: bool = False
+    max_motions: int = MAX_MOTIONS
+    max_iterations: int = MAX_ITERATIONS
 
 
 def output_names(paths: Sequence[str | os.PathLike]) -> list[str]:
@@ -102,7 +106,8 @@ def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: st
         if not path.is_file():
             raise FileNotFoundError(f"no such program file: {path}")
         op = gcode_to_operation(path, options.machine, machine_config=options.machine_config,
-                                mode="strict" if options.strict else "lenient")
+                                mode="strict" if options.strict else "lenient", max_motions=options.max_motions,
+                                max_iterations=options.max_iterations)
         data = report_data(op)
         html_path.write_text(program_page(data, report_figures(op, data)), encoding="utf-8")
         row.update(key_figures(data))
@@ -140,7 +145,8 @@ def _row(path: Path, name: str) -> dict[str, Any]:
 def _failed(row: dict[str, Any], html_path: Path, exc: BaseException) -> dict[str, Any]:
     from .html import error_page
 
-    row["error"] = str(exc) if isinstance(exc, (GcodeError, OSError)) else f"{type(exc).__name__}: {exc}"
+    row["error"] = str(exc) if isinstance(exc, (GcodeError, OSError)) else (
+        f"internal error (a bug in gcodekit, not in the program): {type(exc).__name__}: {exc}")
     html_path.write_text(error_page(row["name"], row["file"], exc), encoding="utf-8")
     return row
 

@@ -3,7 +3,8 @@
 The template ``reports/program_report.ipynb`` holds the same report as the
 HTML page, drawn by the same functions; its cell tagged ``parameters`` is
 replaced by the program and machine, then nbclient runs it in a fresh kernel
-and nbconvert can turn the result into HTML.
+(keeping the widgets' state) and nbconvert can turn the result into HTML that
+shows the widgets' pictures offline (:mod:`gcodekit.widgets.export`).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ def write_notebook(program: str | os.PathLike, out: str | os.PathLike, *, machin
     out : path of the executed notebook
     machine, machine_config : as for :func:`gcodekit.gcode_to_operation`
     html : bool, default: False
-        Also write ``out`` with the suffix ``.notebook.html`` (nbconvert's lab template).
+        Also write ``out`` with the suffix ``.notebook.html`` (nbconvert's lab template, offline).
     template : path, default: ``reports/program_report.ipynb``
 
     Raises
@@ -39,7 +40,8 @@ def write_notebook(program: str | os.PathLike, out: str | os.PathLike, *, machin
         When a cell fails; the message holds the cell's traceback.
     """
     import nbformat
-    from nbclient import NotebookClient
+
+    from ..widgets.export import execute, write_offline_html
 
     template, out = Path(template), Path(out)
     if not template.is_file():
@@ -50,12 +52,8 @@ def write_notebook(program: str | os.PathLike, out: str | os.PathLike, *, machin
     # repr() writes the values as Python literals: a file name cannot become code
     cell.source = (f"program = {str(Path(program).resolve())!r}\nmachine = {machine!r}\n"
                    f"machine_config = {config!r}")
-    NotebookClient(nb, timeout=CELL_TIMEOUT_S, kernel_name="python3",
-                   resources={"metadata": {"path": str(out.parent.resolve())}}).execute()
+    execute(nb, out.parent, timeout=CELL_TIMEOUT_S)
     nbformat.write(nb, out)
     if html:
-        from nbconvert import HTMLExporter
-
-        body, _ = HTMLExporter().from_notebook_node(nb)
-        out.with_name(out.name.removesuffix(".ipynb") + ".notebook.html").write_text(body, encoding="utf-8")
+        write_offline_html(nb, out.with_name(out.name.removesuffix(".ipynb") + ".notebook.html"))
     return out

@@ -100,6 +100,7 @@ class Transpiler:
         turned = np.asarray(w["rotation"]) != 0
         np.logical_or.at(self._rotated_rows, w["command"] if "command" in w else np.arange(turned.size), turned)
         self._incremental_rows = mode_rows(self.op.table, "distance_incremental", "distance_absolute")  # G91
+        self._rotary_axes = [a for a in "ABC" if np.any(np.asarray(w[a.lower()]) != 0)]  # written when used
         self._arc_absolute_rows = mode_rows(self.op.table, "arc_distance_absolute", "arc_distance_incremental")
         # the last cycle command at or before each row (axis words alone repeat it)
         cycles = np.isin(self.op.table.name, [NAME_ID[n] for n in CYCLE_NAMES])
@@ -250,7 +251,7 @@ class Transpiler:
             if motion == 0:
                 continue
             xyz = " ".join(f"{a}{fmt(value(a, p))}" for a in "XYZ")
-            abc = " ".join(f"{a}{fmt(value(a, p))}" for a in "ABC" if np.any(np.asarray(w[a.lower()]) != 0))
+            abc = " ".join(f"{a}{fmt(value(a, p))}" for a in self._rotary_axes)
             coords = f"{xyz} {abc}".rstrip()
             if motion == 1:
                 lines.append(f"{n} G0 {coords}")

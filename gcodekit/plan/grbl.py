@@ -1,12 +1,11 @@
-"""Emulate stage, planning: GRBL 1.1's lookahead, as array code.
+"""Plan stage: GRBL 1.1's lookahead, as array code.
 
 Mirrors grbl 1.1h ``planner.c`` (``plan_buffer_line``: junction deviation
 and per-axis limits along the move's unit vector; ``planner_recalculate``:
 the reverse and forward passes), ``motion_control.c`` (``mc_arc``: arcs cut
 into chords within ``$12`` of the circle) and the ``protocol_buffer_synchronize``
 calls that bring the machine to rest.  GRBL's planner is the ancestor of
-Marlin's, so the two passes and the trapezoid live here and the other
-planners reuse them (:func:`lookahead`, :func:`trapezoid`).
+Marlin's: the two passes and the trapezoid they share are in :mod:`.lookahead`.
 
 GRBL works in mm/min internally; here speeds are mm/s and accelerations
 mm/s^2 (``$120`` is already mm/s^2), which changes no result.
@@ -28,15 +27,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import ConfigError
-from ...parse.table import MOTION_RAPID
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before
-from .scans import backward_min, forward_min
+from ..errors import ConfigError
+from ..parse.table import MOTION_RAPID
+from .lookahead import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
+from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before
 
 if TYPE_CHECKING:
-    from ..operation import Operation
+    from ..emulate.operation import Operation
 
-BLOCK = 1 << 14  # element-wise steps run on this many moves at a time: less fresh memory
 MINIMUM_FEED_RATE = 1.0 / 60.0  # grbl config.h: MINIMUM_FEED_RATE 1.0 mm/min
 MINIMUM_JUNCTION_SPEED = 0.0  # grbl config.h, mm/s
 COS_STRAIGHT = 0.999999  # planner.c: |junction_cos_theta| beyond this is a reversal or a straight line
@@ -131,128 +129,6 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray, ar
         half_chord_d = np.sqrt(arc_tolerance * (2.0 * radius - arc_tolerance))
         segments = np.floor(np.abs(0.5 * angle * radius) / half_chord_d)
     return np.maximum(np.nan_to_num(segments, nan=1.0, posinf=1.0), 1.0)
-
-
-def limit_by_axis_maximum(max_value, unit_vec) -> np.ndarray:
-    """grbl's ``limit_value_by_axis_maximum``: per row, the largest value along
-    ``unit_vec`` whose component on every axis stays within that axis's limit.
-
-    ``max_value`` holds one limit per axis (a number, or an array with one
-    value per row); ``unit_vec`` is a sequence of per-axis columns.
-    """
-    limit = np.full(np.shape(unit_vec[0]), np.inf)
-    for cap, u in zip(max_value, unit_vec):
-        u = np.abs(u)
-        ratio = np.divide(cap, u, out=np.full(u.shape, np.inf), where=u > 0)
-        np.minimum(limit, ratio, out=limit)
-    return limit
-
-
-# -- the passes and the trapezoid, shared with marlin.py and reprapfirmware.py ---------
-
-
-def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.ndarray, *,
-              rest_v2: float = 0.0, nominal_length: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Entry and exit speeds (squared) after the reverse and forward passes.
-
-    Parameters
-    ----------
-    max_entry_v2 : ndarray
-        Cap on each move's entry speed (the junction limit; for the first
-        move after a rest, the speed it may start at).
-    delta_v2 : ndarray
-        ``2 * accel * move_d``: what a move can add to (or shed from) v^2.
-    rest_after : ndarray of bool
-        The machine stops after this move (the last one is always a stop).
-    rest_v2 : float, default: 0
-        Speed squared at a stop (Marlin: ``MINIMUM_PLANNER_SPEED`` squared).
-    nominal_length : ndarray of bool, optional
-        Marlin's ``nominal_length`` flag: such a move always enters at its
-        cap, and the next move's entry is not checked against it.
-
-    Returns
-    -------
-    entry_v2, exit_v2 : ndarray
-
-    Notes
-    -----
-    grbl ``planner_recalculate``, reverse then forward::
-
-        for i in reversed(range(n)):   # next entry: rest_v2 after a stop
-            entry[i] = min(max_entry[i], entry[i+1] + delta[i])
-        for i in range(1, n):          # no limit across a stop
-            entry[i] = min(entry[i], entry[i-1] + delta[i-1])
-
-    Both are the scans of :mod:`.scans`.  A stop (or a ``nominal_length``
-    move) cuts each recurrence: giving that move an increment equal to its
-    own bound makes the minimum pick the bound whatever comes next.
-    """
-    n = max_entry_v2.size
-    free = rest_after.copy()
-    if nominal_length is not None:
-        free |= nominal_length
-    bound = np.where(rest_after, np.minimum(max_entry_v2, rest_v2 + delta_v2), max_entry_v2)
-    if nominal_length is not None:
-        bound = np.where(nominal_length, max_entry_v2, bound)
-    reverse_v2 = backward_min(bound, np.where(free, bound, delta_v2))
-    forward_inc = delta_v2.copy()
-    cut = np.flatnonzero(free[:-1])
-    forward_inc[cut] = reverse_v2[cut + 1]
-    entry_v2 = forward_min(reverse_v2, forward_inc, first=float(reverse_v2[0])) if n else reverse_v2
-    exit_v2 = np.where(rest_after, rest_v2, np.r_[entry_v2[1:], rest_v2])
-    return entry_v2, exit_v2
-
-
-def trapezoid(move_d: np.ndarray, accel: np.ndarray, entry_v2: np.ndarray, nominal_v2: np.ndarray,
-              exit_v2: np.ndarray) -> PlanResult:
-    """Phase speeds and durations of trapezoidal moves.
-
-    Accelerate from the entry speed, cruise at the nominal speed, brake to
-    the exit speed; a move too short to cruise peaks where accelerating and
-    braking meet (Marlin's ``intersection_distance``, grbl's ``st_prep_buffer``
-    ramp).  An entry above what the move can brake from is clipped, as the
-    firmware's step generator does.
-    """
-    n = move_d.size
-    result = PlanResult(np.empty(n), np.empty(n), np.empty(n), np.asarray(accel, float), np.empty(n), np.empty(n),
-                        np.empty(n))
-    for lo in range(0, n, BLOCK):
-        sl = slice(lo, min(lo + BLOCK, n))
-        _trapezoid_block(move_d[sl], accel[sl], entry_v2[sl], nominal_v2[sl], exit_v2[sl], result, sl)
-    return result
-
-
-def _trapezoid_block(move_d, accel, entry_v2, nominal_v2, exit_v2, result: PlanResult, sl: slice) -> None:
-    half_inv_accel = 0.5 / accel
-    accel_d = (nominal_v2 - entry_v2) * half_inv_accel
-    decel_d = (nominal_v2 - exit_v2) * half_inv_accel
-    short = accel_d + decel_d > move_d
-    # where they meet: entry_v2 + 2 a x = exit_v2 + 2 a (d - x)
-    meet_d = np.clip((move_d + (exit_v2 - entry_v2) * half_inv_accel) * 0.5, 0.0, move_d)
-    accel_d = np.where(short, meet_d, np.maximum(accel_d, 0.0))
-    cruise_v2 = np.where(short, entry_v2 + 2.0 * accel * meet_d, nominal_v2)
-    start_v2 = np.minimum(np.minimum(entry_v2, nominal_v2), cruise_v2)
-    decel_d = np.where(short, move_d - meet_d, np.clip(decel_d, 0.0, move_d - accel_d))
-    end_v2 = np.maximum(cruise_v2 - 2.0 * accel * decel_d, 0.0)
-    cruise_d = np.maximum(move_d - accel_d - decel_d, 0.0)
-    start_v, cruise_v, end_v = np.sqrt(start_v2), np.sqrt(cruise_v2), np.sqrt(end_v2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        result.accel_t[sl] = np.where(accel_d > 0, (cruise_v - start_v) / accel, 0.0)
-        result.cruise_t[sl] = np.where(cruise_d > 0, cruise_d / cruise_v, 0.0)
-        result.decel_t[sl] = np.where(decel_d > 0, (cruise_v - end_v) / accel, 0.0)
-    result.start_v[sl], result.cruise_v[sl], result.end_v[sl] = start_v, cruise_v, end_v
-
-
-def empty_result() -> PlanResult:
-    empty = np.zeros(0)
-    return PlanResult(empty, empty, empty, empty, empty, empty, empty)
-
-
-def unit_vectors(columns) -> tuple[np.ndarray, list[np.ndarray]]:
-    """Length and unit-vector columns of the vectors given as per-axis columns (zero vectors stay zero)."""
-    length = np.sqrt(sum(c * c for c in columns))
-    inverse = np.divide(1.0, length, out=np.zeros_like(length), where=length > 0)
-    return length, [c * inverse for c in columns]
 
 
 # -- grbl ---------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Emulate stage, planning: firmware motion planners, chosen by name.
+"""Plan stage: firmware motion planners, chosen by name.
 
 A machine preset names its planner (``planner = "klipper"``); each planner
 module has a settings class built from the preset's ``[planner]`` table or
@@ -16,19 +16,19 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from ...errors import ConfigError, did_you_mean
-from .base import PlannedMoves, PlannerMoves, PlanResult
+from ..errors import ConfigError, did_you_mean
+from .moves import PlannedMoves, PlannerMoves, PlanResult
 
 if TYPE_CHECKING:
-    from ..operation import Operation
+    from ..emulate.operation import Operation
 
 #: Planner name -> (module, settings class, reader of the firmware's own config file)
 PLANNERS = {
-    "klipper": ("gcodekit.emulate.planners.klipper", "KlipperConfig", "from_printer_cfg"),
-    "marlin": ("gcodekit.emulate.planners.marlin", "MarlinConfig", "from_m503"),
-    "grbl": ("gcodekit.emulate.planners.grbl", "GrblConfig", "from_settings"),
-    "reprapfirmware": ("gcodekit.emulate.planners.reprapfirmware", "RrfConfig", "from_config_g"),
-    "motion_profile": ("gcodekit.emulate.planners.motion_profile", "MotionProfileConfig", "from_config_file"),
+    "klipper": ("gcodekit.plan.klipper", "KlipperConfig", "from_printer_cfg"),
+    "marlin": ("gcodekit.plan.marlin", "MarlinConfig", "from_m503"),
+    "grbl": ("gcodekit.plan.grbl", "GrblConfig", "from_settings"),
+    "reprapfirmware": ("gcodekit.plan.reprapfirmware", "RrfConfig", "from_config_g"),
+    "motion_profile": ("gcodekit.plan.motion_profile", "MotionProfileConfig", "from_config_file"),
 }
 
 

@@ -1,4 +1,4 @@
-"""Emulate stage, planning: Marlin 2's lookahead, as array code.
+"""Plan stage: Marlin 2's lookahead, as array code.
 
 Mirrors Marlin 2.1 ``module/planner.cpp`` (``_populate_block``: feed and
 acceleration limits per axis, classic jerk or junction deviation at the
@@ -37,14 +37,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import ConfigError
-from .base import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force,
-                   m204_in_force, speed_factor)
-from .grbl import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
-
+from ..errors import ConfigError
+from .lookahead import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
+from .moves import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before,
+                    m204_in_force, settings_in_force, speed_factor)
 
 if TYPE_CHECKING:
-    from ..operation import Operation
+    from ..emulate.operation import Operation
 
 COS_REVERSAL = 0.999999  # planner.cpp: a junction_cos_theta above this is a full reversal
 COS_OCTAGON = -0.7071067812  # JD_HANDLE_SMALL_SEGMENTS: junctions sharper than 135 degrees
@@ -196,22 +195,6 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray,
     by_length = np.floor(travel_d / max_arc_segment_mm)
     by_angle = np.ceil(min_circle_segments * np.abs(angle) / (2.0 * np.pi) - 1e-9)
     return np.maximum(np.maximum(by_length, by_angle), 1.0)
-
-
-def settings_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray, letter: str,
-                      initial: float, scale: float | np.ndarray = 1.0) -> np.ndarray | float:
-    """Per move, the last value of word ``letter`` among ``rows`` before it (``initial`` before any).
-
-    ``scale`` converts the word to the planner's unit (one factor, or one
-    per row).  Returns a number when one value holds for every move (the
-    common case: the limits are set once at the top), else an array.
-    """
-    values = op.table.param(letter)[rows] * scale
-    given = ~np.isnan(values)
-    if not given.any():
-        return float(initial)
-    per_move = in_force(moves, rows[given], values[given], initial)
-    return float(per_move[0]) if per_move.min() == per_move.max() else per_move
 
 
 def _program_limits(op: "Operation", moves: PlannerMoves, config: MarlinConfig) -> dict:

@@ -1,4 +1,4 @@
-"""Emulate stage, planning: the moves a firmware plans, and what it planned.
+"""Plan stage: the moves a firmware plans, and what it planned.
 
 A firmware does not plan G-code lines; it plans *moves*: straight segments
 of the toolhead (arcs cut into chords by the firmware's own rule) and
@@ -18,11 +18,11 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from ...parse.table import NAME_ID
-from .. import arcs
+from ..emulate import arcs
+from ..parse.table import NAME_ID
 
 if TYPE_CHECKING:
-    from ..operation import Operation
+    from ..emulate.operation import Operation
 
 #: Chords of each arc, from its length (mm), swept angle (rad), radius (mm)
 #: and requested speed (mm/s): how many segments.
@@ -167,6 +167,22 @@ def m204_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray,
     return out
 
 
+def settings_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray, letter: str,
+                      initial: float, scale: float | np.ndarray = 1.0) -> np.ndarray | float:
+    """Per move, the last value of word ``letter`` among ``rows`` before it (``initial`` before any).
+
+    ``scale`` converts the word to the planner's unit (one factor, or one
+    per row).  Returns a number when one value holds for every move (the
+    common case: the limits are set once at the top), else an array.
+    """
+    values = op.table.param(letter)[rows] * scale
+    given = ~np.isnan(values)
+    if not given.any():
+        return float(initial)
+    per_move = in_force(moves, rows[given], values[given], initial)
+    return float(per_move[0]) if per_move.min() == per_move.max() else per_move
+
+
 def happens_before(moves: PlannerMoves, rows: np.ndarray) -> np.ndarray:
     """Per move: does one of ``rows`` come between the previous move and this one?"""
     if rows.size == 0 or len(moves) == 0:
@@ -215,7 +231,21 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     is_arc = w["motion"][idx] >= 3
     if arc_segments is None or not is_arc.any():
         return PlannerMoves(start, end, speed, rows[idx], idx)
-    return _with_segmented_arcs(w, idx, is_arc, start, end, speed, rows[idx], arc_segments)
+    return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows[idx], arc_segments)
+
+
+def _chords_within_limit(op, chords: np.ndarray, rows: np.ndarray, room: int) -> np.ndarray:
+    """Chord counts of the arcs, cut down when they would pass ``max_motions`` (an arc with a huge
+    radius can ask for billions); the error names the arc asking for the most."""
+    total = float(chords.sum())
+    if total <= room:
+        return chords.astype(np.int64)
+    worst = int(np.argmax(chords))
+    op.diagnostics.report(int(op.table.line[rows[worst]]), 1, f"arcs would be cut into {total:,.0f} moves, more than "
+                          f"max_motions={op.max_motions:,}; planned with fewer chords (this one asked for "
+                          f"{chords[worst]:,.0f}), so their times are approximate", kind="limit")
+    scale = max(room, chords.size) / total
+    return np.maximum(np.floor(chords * scale), 1.0).astype(np.int64)
 
 
 def _move_ends(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -244,8 +274,9 @@ def _move_ends(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.nda
     return start, end
 
 
-def _with_segmented_arcs(w, idx, is_arc, move_start, move_end, speed, rows, arc_segments) -> PlannerMoves:
+def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc_segments) -> PlannerMoves:
     """Replace each arc waypoint by its chords (Klipper's and Marlin's plan_arc)."""
+    w = op.waypoints
     counts = np.ones(idx.size, np.int64)
     arc_idx = idx[is_arc]
     centers = np.column_stack([w["cx"], w["cy"], w["cz"]])[arc_idx]
@@ -267,7 +298,8 @@ def _with_segmented_arcs(w, idx, is_arc, move_start, move_end, speed, rows, arc_
         radius[sel] = np.hypot(*(s2 - c2).T)
     rise = end[np.arange(arc_idx.size), axes[:, 2]] - start[np.arange(arc_idx.size), axes[:, 2]]
     travel = np.hypot(radius * angle, rise)
-    counts[is_arc] = np.maximum(arc_segments(travel, angle, radius, speed[is_arc]).astype(np.int64), 1)
+    chords = np.maximum(arc_segments(travel, angle, radius, speed[is_arc]), 1.0)
+    counts[is_arc] = _chords_within_limit(op, chords, rows[is_arc], room=op.max_motions - (idx.size - arc_idx.size))
 
     total = int(counts.sum())
     owner = np.repeat(np.arange(idx.size), counts)

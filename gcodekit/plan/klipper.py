@@ -1,4 +1,4 @@
-"""Emulate stage, planning: Klipper's lookahead, as array code.
+"""Plan stage: Klipper's lookahead, as array code.
 
 Mirrors klippy's ``toolhead.py`` (Move, LookAheadQueue.flush; Klipper
 v0.12+, with ``minimum_cruise_ratio``), ``kinematics/cartesian.py`` (Z
@@ -22,12 +22,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import ConfigError
-from .base import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
+from ..errors import ConfigError
+from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
 
 if TYPE_CHECKING:
-    from ..operation import Operation
+    from ..emulate.operation import Operation
 
 EXTRUDE_ONLY_ACCEL = 99999999.9  # klippy: "self.accel = 99999999.9" for extrude-only moves
 NO_LIMIT_V2 = 999999999.9  # klippy's next_junction_v2 default

@@ -1,4 +1,4 @@
-"""Emulate stage, planning: the planner passes as array scans.
+"""Plan stage: the planner passes as array scans.
 
 Every lookahead planner has two recurrences of the same shape, on squared
 velocities ``v2``:

@@ -1,4 +1,4 @@
-"""Emulate stage, planning: the GRBL-style :class:`~gcodekit.emulate.motion.MotionProfile` as a planner.
+"""Plan stage: the GRBL-style :class:`~gcodekit.plan.profile.MotionProfile` as a planner.
 
 For machines without a firmware model of their own (``generic``,
 ``linuxcnc``): a preset's ``[planner]`` table with ``name =
@@ -26,14 +26,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import ConfigError, check_choice
-from ...parse.table import NAME_ID
-from .. import arcs
-from ..motion import BAAMMotionProfile, MotionProfile
-from .base import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
+from ..errors import ConfigError, check_choice
+from ..emulate import arcs
+from ..parse.table import NAME_ID
+from .profile import BAAMMotionProfile, MotionProfile
+from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
 
 if TYPE_CHECKING:
-    from ..operation import Operation
+    from ..emulate.operation import Operation
 
 #: Commands before which the machine has come to rest.
 STOP_NAMES = (
@@ -65,7 +65,7 @@ class MotionProfileConfig:
     arc_resolution : float
         mm, longest chord an arc is cut into.
     machine_rules : {"", "baam"}
-        ``"baam"`` plans with :class:`~gcodekit.emulate.motion.BAAMMotionProfile`
+        ``"baam"`` plans with :class:`~gcodekit.plan.profile.BAAMMotionProfile`
         (rest before and after each layer change, per-axis speed caps).
     axis_max_velocity : list of 3 floats or None
         mm/s, X, Y and Z speed caps for ``"baam"``.

@@ -1,4 +1,4 @@
-"""Emulate stage, planning: RepRapFirmware 3's lookahead, as array code.
+"""Plan stage: RepRapFirmware 3's lookahead, as array code.
 
 Mirrors RepRapFirmware 3.4 ``Movement/DDA.cpp`` (``InitStandardMove``: the
 direction vector normalised on XYZ, acceleration and speed by
@@ -32,15 +32,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import ConfigError
-from .base import (PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, m204_in_force,
-                   speed_factor)
-from .grbl import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
+from ..errors import ConfigError
+from .lookahead import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
+from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, m204_in_force,
+                    settings_in_force, speed_factor)
 
-from .marlin import settings_in_force
 
 if TYPE_CHECKING:
-    from ..operation import Operation
+    from ..emulate.operation import Operation
 
 AXES = "XYZE"
 #: Commands RRF runs only once the moves before them are done (LockMovementAndWaitForStandstill).

@@ -1,0 +1,241 @@
+"""Widgets stage: VelocityPlot, commanded feed against the planner's speed.
+
+The profile (:func:`gcodekit.analysis.velocity_profile`, four corners per
+planned move) can hold half a million points; the browser gets at most a
+few thousand for the range shown: every corner when they fit, else the
+lowest and highest speed per bin (a line plot drawn at pixel density looks
+the same).  ``link(viewer)`` follows a :class:`LayerViewer`'s range.
+"""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+import anywidget
+import ipywidgets as widgets
+import numpy as np
+import traitlets
+
+from .display import PictureDisplay, friendly, message_html
+from .picture import message_figure, new_figure
+from .toolpath import Toolpath, ToolpathError, source_lines
+
+#: Bins of the envelope: about one per pixel of a notebook-wide plot.
+BINS = 1200
+X_LABELS = {"time": "time (s)", "distance": "distance (mm)"}
+
+
+class VelocityView(anywidget.AnyWidget):
+    """The canvas plot: the points of the range shown and how to draw them."""
+
+    _esm = Path(__file__).parent / "static" / "velocity.js"
+    x = traitlets.Bytes(b"").tag(sync=True)
+    planned_lo = traitlets.Bytes(b"").tag(sync=True)
+    planned_hi = traitlets.Bytes(b"").tag(sync=True)
+    commanded = traitlets.Bytes(b"").tag(sync=True)
+    line = traitlets.Bytes(b"").tag(sync=True)
+    move = traitlets.Bytes(b"").tag(sync=True)
+    mode = traitlets.Unicode("raw").tag(sync=True)
+    corners = traitlets.Int(4).tag(sync=True)
+    range = traitlets.List(traitlets.Float(), default_value=[0.0, 1.0]).tag(sync=True)
+    ymax = traitlets.Float(1.0).tag(sync=True)
+    x_label = traitlets.Unicode("time (s)").tag(sync=True)
+    title = traitlets.Unicode("").tag(sync=True)
+    picked = traitlets.List().tag(sync=True)
+    height = traitlets.Int(300).tag(sync=True)
+
+
+class VelocityPlot(PictureDisplay):
+    """Planned speed (accelerating, cruising, decelerating) and commanded feed over time or distance.
+
+    Parameters
+    ----------
+    op : Operation, AdditivePart or path
+    layers : (int, int), default: None
+        Layers (or Z levels) to show, both included; None shows the whole program.
+    x : {"time", "distance"}, default: "time"
+    height : int, default: 300
+
+    Attributes
+    ----------
+    range : tuple of float
+        The x range shown.
+    picked : ipywidgets.HTML
+        The move and source line of the point last clicked.
+
+    Examples
+    --------
+    ::
+
+        plot = VelocityPlot(op, layers=(3, 3))
+        plot.link(viewer)   # follows viewer.layers and viewer.moves
+    """
+
+    def __init__(self, op, layers: tuple[int, int] | None = None, x: str = "time", *, height: int = 300):
+        from ..errors import check_choice
+
+        check_choice("x", x, tuple(X_LABELS))
+        self.x_name = x
+        self.error: str | None = None
+        self.path: Toolpath | None = None
+        self._linked = None
+        self.view = VelocityView(height=height, x_label=X_LABELS[x], layout=widgets.Layout(width="100%"))
+        self.picked = widgets.HTML()
+        try:
+            self.path = Toolpath.of(op)
+            self._profile()
+        except ToolpathError as exc:
+            self.error = str(exc)
+        except Exception as exc:  # a message in the widget, not a traceback
+            self.error = friendly(exc)
+        if self.error is not None:
+            self.widget = widgets.VBox([widgets.HTML(message_html(self.error))])
+            return
+        self.view.observe(self._on_pick, "picked")
+        self.widget = widgets.VBox([self.view, self.picked], layout=widgets.Layout(width="100%"))
+        if layers is None:
+            self.show(self.xs[0], self.xs[-1])
+        else:
+            self.show_layers(*layers)
+
+    # -- data ---------------------------------------------------------------------
+
+    def _profile(self) -> None:
+        from ..analysis import velocity_profile
+
+        op = self.path.op
+        frame = velocity_profile(op)
+        if frame.empty:
+            raise ToolpathError(f"{op.file}: no moves to plot")
+        self.times = frame["time"].to_numpy(float)
+        self.xs = frame[self.x_name].to_numpy(float)
+        self.planned = frame["planned"].to_numpy(float)
+        self.commanded = frame["commanded"].to_numpy(float)
+        self.lines = frame["line"].to_numpy(np.int64)
+        if op.plan is not None:
+            waypoint, self.corners = np.repeat(op.plan[0].waypoint, 4), 4
+        else:
+            waypoint, self.corners = np.repeat(np.flatnonzero(np.asarray(op.waypoints["motion"]) > 0), 2), 2
+        self.moves = np.clip(np.searchsorted(self.path.move_rows, waypoint), 0, len(self.path.move_rows) - 1)
+        self.ymax = float(np.nanmax(np.r_[self.planned, self.commanded, 1e-9])) * 1.05
+
+    def points(self, x0: float, x1: float, bins: int = BINS) -> dict[str, np.ndarray]:
+        """What is drawn for ``x0..x1``: every corner, or per-bin min/max when more than ``3 * bins``.
+
+        Returns ``x, lo, hi, commanded, line, move`` and ``mode`` (``"raw"`` or ``"binned"``).
+        """
+        a, b = np.searchsorted(self.xs, [x0, x1], side="left")[0], np.searchsorted(self.xs, x1, side="right")
+        a = max(a - 1, 0)  # the corner before the range starts its first line
+        a -= a % self.corners  # whole moves: corner k of the points is then corner k % corners of its move
+        x, planned = self.xs[a:b], self.planned[a:b]
+        if x.size <= 3 * bins:
+            return {"x": x, "lo": planned, "hi": planned, "commanded": self.commanded[a:b], "line": self.lines[a:b],
+                    "move": self.moves[a:b], "mode": "raw"}
+        edges = np.linspace(x0, x1, bins + 1)
+        starts = np.unique(np.searchsorted(x, edges[:-1]))
+        starts = starts[starts < x.size]
+        return {"x": x[starts], "lo": np.minimum.reduceat(planned, starts),
+                "hi": np.maximum.reduceat(planned, starts),
+                "commanded": np.maximum.reduceat(self.commanded[a:b], starts),
+                "line": self.lines[a:b][starts], "move": self.moves[a:b][starts], "mode": "binned"}
+
+    # -- what is shown ---------------------------------------------------------------
+
+    def show(self, x0: float, x1: float) -> None:
+        """Show ``x0..x1`` (seconds or millimetres, as ``x``)."""
+        if x1 <= x0:
+            x1 = x0 + 1e-6
+        if getattr(self, "range", None) == (float(x0), float(x1)):
+            return  # a linked viewer reports one step through two controls
+        self.range = (float(x0), float(x1))
+        p = self.points(x0, x1)
+        f32 = lambda v: np.asarray(v, np.float32).tobytes()  # noqa: E731
+        with self.view.hold_sync():
+            self.view.x, self.view.planned_lo, self.view.planned_hi = f32(p["x"]), f32(p["lo"]), f32(p["hi"])
+            self.view.commanded = f32(p["commanded"])
+            self.view.line = np.asarray(p["line"], np.int32).tobytes()
+            self.view.move = np.asarray(p["move"], np.int32).tobytes()
+            self.view.mode, self.view.corners = p["mode"], self.corners
+            self.view.range, self.view.ymax = list(self.range), self.ymax
+            self.view.title = f"{Path(self.path.op.file).name}: {x0:.6g}-{x1:.6g} {X_LABELS[self.x_name].split(' ')[1]}"
+
+    def show_moves(self, first: int, last: int) -> None:
+        """Show the moves ``first..last`` (indices of the toolpath's moves)."""
+        start, end = self.path.times()
+        t0, t1 = start[first], end[last]
+        if self.x_name == "distance":
+            t0, t1 = np.interp([t0, t1], self.times, self.xs)
+        self.show(t0, t1)
+
+    def show_layers(self, lo: int, hi: int) -> None:
+        """Show layers (or Z levels) ``lo..hi``."""
+        gm = self.path.group_move
+        first, last = int(gm[lo]), int(gm[hi + 1]) - 1
+        self.show_moves(first, max(last, first))
+
+    def link(self, viewer) -> "VelocityPlot":
+        """Follow ``viewer``'s layer range and move slider (a :class:`LayerViewer`); returns self.
+
+        A point clicked here then moves the viewer to that move.
+        """
+        if self.error is not None or viewer.error is not None:
+            return self
+        self._linked = viewer
+
+        def follow(change=None):
+            lo, hi = viewer.layers.value
+            first, current = int(viewer.path.group_move[lo]), viewer.current_move
+            self.show_moves(first, max(current, first))
+
+        viewer.layers.observe(follow, "value")
+        viewer.moves.observe(follow, "value")
+        follow()
+        return self
+
+    def _on_pick(self, change) -> None:
+        picked = change["new"]
+        if not picked:
+            return
+        move, line = int(picked[0]), int(picked[1])
+        lines = source_lines(self.path.op) or []
+        text = html.escape(lines[line - 1]) if 0 < line <= len(lines) else ""
+        self.picked.value = (f'<div class="gcodekit-picked" style="font:12px monospace">move {move}, line {line}: '
+                             f'<b>{text}</b></div>')
+        if self._linked is not None:
+            self._linked.show_move(move)
+
+    def figure(self, size: tuple[int, int] = (900, 300)):
+        """The current plot as a matplotlib Figure."""
+        if self.error is not None:
+            return message_figure(self.error)
+        p = self.points(*self.range)
+        fig = new_figure(size)
+        ax = fig.add_axes([0.07, 0.17, 0.9, 0.72])
+        x = p["x"]
+        ax.step(x, p["commanded"], where="post", color="#555", linestyle="--", linewidth=1, label="commanded")
+        if p["mode"] == "raw" and self.corners == 4:
+            colors = np.array(["#2ca02c", "#1f77b4", "#d62728", "#bbbbbb"])
+            from matplotlib.collections import LineCollection
+
+            segs = np.stack([np.column_stack([x[:-1], p["hi"][:-1]]), np.column_stack([x[1:], p["hi"][1:]])], axis=1)
+            phase = np.arange(x.size - 1) % 4  # the points start at a move's first corner
+            ax.add_collection(LineCollection(segs, colors=colors[phase], linewidths=1.3))
+            for name, c in zip(("accelerating", "cruising", "decelerating"), colors):
+                ax.plot([], [], color=c, label=name)
+        elif p["mode"] == "raw":
+            ax.plot(x, p["hi"], color="#1f77b4", linewidth=1.2, label="planned")
+        else:
+            ax.vlines(x, p["lo"], p["hi"], color="#1f77b4", linewidth=0.8, label="planned (min-max per bin)")
+        ax.set_xlim(*self.range)
+        ax.set_ylim(0, self.ymax)
+        ax.set_xlabel(X_LABELS[self.x_name])
+        ax.set_ylabel("speed (mm/s)")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper left", bbox_to_anchor=(0.0, 1.16), ncol=4, fontsize=8, frameon=False)
+        return fig
+
+    def __repr__(self) -> str:
+        if self.error is not None:
+            return f"<VelocityPlot: {self.error}>"
+        return f"<VelocityPlot {Path(self.path.op.file).name!r}: {self.x_name} {self.range[0]:.6g}-{self.range[1]:.6g}>"

@@ -1,0 +1,315 @@
+"""The notebook widgets as plain Python objects: no browser, the controls set from Python.
+
+Expected values come from the emulator's own columns (``analysis.layers``,
+the waypoints) or are worked out by hand in the test.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("anywidget")
+
+import gcodekit  # noqa: E402
+from gcodekit.analysis import layers as waypoint_layers  # noqa: E402
+from gcodekit.widgets import LayerViewer, StageDiff, VelocityPlot  # noqa: E402
+from gcodekit.widgets.checks import check  # noqa: E402
+from gcodekit.widgets.toolpath import Toolpath  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+CUBE = ROOT / "examples" / "cube20_prusaslicer_marlin.gcode"
+MILL = ROOT / "examples" / "bracket_mill.ngc"
+PROGRAMS = ROOT / "notebooks" / "worksheets" / "programs"
+# two layers of a square: 4 extruding moves each, a travel move between them
+TWO_LAYERS = """M83
+G1 Z0.2 F600
+G1 X10 E1
+G1 Y10 E1
+G1 X0 E1
+G1 Y0 E1
+G0 Z0.4
+G1 X10 E1
+G1 Y10 E1
+G1 X0 E1
+G1 Y0 E1
+"""
+
+
+@pytest.fixture(scope="module")
+def cube():
+    return gcodekit.gcode_to_operation(CUBE)
+
+
+def ink(image: np.ndarray) -> np.ndarray:
+    """Pixels that are not (near) white."""
+    return image.min(axis=2) < 235
+
+
+def ink_height(image: np.ndarray) -> int:
+    # the legend is on the right, the title on top
+    rows = np.flatnonzero(ink(image[int(image.shape[0] * 0.07):, : int(image.shape[1] * 0.75)]).any(axis=1))
+    return int(rows[-1] - rows[0]) if rows.size else 0
+
+
+# -- the toolpath the viewers draw --------------------------------------------------------
+
+
+def test_toolpath_groups_follow_the_emulators_layers(cube):
+    path = Toolpath.of(cube)
+    layer = waypoint_layers(cube)[path.move_rows]
+    for k in (0, 7, 55, path.n_groups - 1):
+        moves = np.arange(path.group_move[k], path.group_move[k + 1])
+        assert np.all(np.maximum(layer[moves], 0) == k)  # start code goes with layer 0
+    a, b = path.group_slice(5, 9)
+    assert a == path.move_seg[path.group_move[5]] and b == path.move_seg[path.group_move[10]]
+    assert path.n_groups == cube.get_statistics()["layers"] == 100
+
+
+def test_toolpath_segments_by_hand():
+    op = gcodekit.gcode_to_operation(TWO_LAYERS, "marlin", plan=False)
+    path = Toolpath.of(op)
+    assert path.group_labels == ["layer 0", "layer 1"]
+    # a layer starts at its first extruding move: the Z lift ends layer 0
+    assert path.moves_in(0) == 6 and path.moves_in(1) == 4
+    # layer 1's second move is G1 Y10 (line 9) from (10, 0, 0.4)
+    move = path.group_move[1] + 1
+    s = path.move_seg[move]
+    assert path.start[s].tolist() == [10.0, 0.0, 0.4] and path.end[s].tolist() == [10.0, 10.0, 0.4]
+    assert path.line_of(move) == 9
+    assert path.kind[path.move_seg[path.group_move[1] - 1]] == 1  # the Z lift lays nothing: travel
+    assert path.kind[path.move_seg[path.group_move[1]]] == 0
+
+
+def test_arcs_are_split_into_chords():
+    op = gcodekit.gcode_to_operation("G21 G90\nG0 X10 Y0\nG3 X-10 Y0 I-10 J0 F600\nM2\n", "linuxcnc", plan=False)
+    path = Toolpath.of(op, "line")
+    arc = slice(path.move_seg[1], path.move_seg[2])
+    radii = np.hypot(path.end[arc, 0], path.end[arc, 1])
+    assert path.move_seg[2] - path.move_seg[1] == 36  # 180 degrees in 5-degree chords
+    np.testing.assert_allclose(radii, 10.0)
+
+
+def test_mill_steps_by_z_level_or_line():
+    op = gcodekit.gcode_to_operation(MILL)
+    by_z = Toolpath.of(op)
+    assert by_z.group_by == "z" and by_z.group_labels[0] == "Z -0.5"  # the facing pass is the first level
+    # every level's feed moves at its height (a level changes where the cutting height does)
+    for k, label in enumerate(by_z.group_labels):
+        moves = np.arange(by_z.group_move[k], by_z.group_move[k + 1])
+        cuts = by_z.move_rows[moves][by_z.kind[by_z.move_seg[moves]] == 0]
+        assert np.all(np.round(op.waypoints["z"][cuts], 3) == float(label[2:]))
+    by_line = Toolpath.of(op, "line")
+    lines = [by_line.line_of(m) for m in range(len(by_line.move_rows))]
+    assert by_line.n_groups == len(set(lines)) and by_line.group_labels[0] == f"line {lines[0]}"
+
+
+# -- LayerViewer ----------------------------------------------------------------------------
+
+
+def test_one_layer_is_not_the_whole_part(cube):
+    viewer = LayerViewer(cube)
+    whole = viewer.screenshot()
+    viewer.layers.value = (50, 50)
+    one = viewer.screenshot()
+    assert whole.shape == one.shape == (600, 800, 3)
+    assert ink(one).sum() < 0.3 * ink(whole).sum()
+    assert ink_height(one) < 0.6 * ink_height(whole)  # a 20 mm square seen at 30 degrees, not the 20 mm cube
+    path = viewer.path
+    assert viewer.moves.max == path.moves_in(50) - 1 == viewer.moves.value
+    assert viewer.span == path.group_slice(50, 50)
+
+
+def test_move_slider_follows_the_source_lines(cube):
+    viewer = LayerViewer(cube)
+    viewer.layers.value = (3, 3)
+    rows = np.flatnonzero(np.maximum(waypoint_layers(cube), 0) == 3)
+    moving = rows[(cube.waypoints["motion"][rows] > 0) & (cube.waypoints["distance"][rows] > 0)]
+    assert viewer.moves.max == moving.size - 1
+    viewer.moves.value = 4
+    command = cube.waypoints["command"][moving[4]] if "command" in cube.waypoints else moving[4]
+    assert viewer.current_line() == int(cube.table.line[command])
+    assert f'data-line="{viewer.current_line()}"' in viewer.code.value
+    partial = viewer.screenshot()
+    viewer.moves.value = viewer.moves.max
+    assert ink(partial).sum() < ink(viewer.screenshot()).sum()
+
+
+def test_a_new_colouring_changes_the_colours(cube):
+    viewer = LayerViewer(cube, color_by="feature")
+    viewer.layers.value = (10, 10)
+    by_feature = viewer.screenshot()
+    viewer.color_by.value = "speed"
+    by_speed = viewer.screenshot()
+    assert ink(by_feature[:, :560]).sum() == pytest.approx(ink(by_speed[:, :560]).sum(), rel=0.05)  # the same lines
+
+    def colours(image):
+        part = image[:, :560][ink(image[:, :560])]
+        return {tuple(c) for c in (part // 32).tolist()}
+
+    assert len(colours(by_feature) ^ colours(by_speed)) > 5
+    green = np.all(np.abs(by_feature[:, :560].astype(int) - (44, 160, 44)) < 30, axis=2).sum()  # external perimeter
+    assert green > 200 and np.all(np.abs(by_speed[:, :560].astype(int) - (44, 160, 44)) < 30, axis=2).sum() < green / 4
+
+
+def test_every_colouring_is_offered_and_drawn(cube):
+    viewer = LayerViewer(cube)
+    assert {"feature", "speed", "feed", "layer", "time", "tool", "flow"} <= set(viewer.color_by.options)
+    for by in ("flow", "layer", "z"):
+        viewer.color_by.value = by
+        assert viewer.view.title and len(viewer.view.values) == 4 * viewer.path.n_segments
+
+
+def test_screenshot_follows_the_browsers_camera(cube):
+    """The camera the browser sends back (after a drag) is the one screenshot() draws with."""
+    viewer = LayerViewer(cube)
+    viewer.layers.value = (30, 30)
+    viewer.view.camera = {"azimuth": -90.0, "elevation": 89.9, "zoom": 1.0, "target": [0.0, 0.0, 0.0]}  # from above
+    image = viewer.screenshot()[int(600 * 0.07):, :560]  # below the title, left of the legend
+    rows, cols = np.flatnonzero(ink(image).any(axis=1)), np.flatnonzero(ink(image).any(axis=0))
+    # layer 30 of the cube from above: a 20 mm square (its perimeters), as wide as it is tall
+    assert rows[-1] - rows[0] == pytest.approx(cols[-1] - cols[0], abs=3)
+    viewer.view.camera = {"azimuth": -90.0, "elevation": 89.9, "zoom": 2.0, "target": [0.0, 0.0, 0.0]}
+    zoomed = viewer.screenshot()[int(600 * 0.07):, :560]
+    assert np.ptp(np.flatnonzero(ink(zoomed).any(axis=0))) == pytest.approx(2 * (cols[-1] - cols[0]), rel=0.05)
+
+
+def test_rich_display_carries_a_png(cube):
+    viewer = LayerViewer(cube)
+    bundle = viewer._repr_mimebundle_()
+    assert bundle["image/png"].startswith(b"\x89PNG")
+    assert "application/vnd.jupyter.widget-view+json" in bundle
+
+
+def test_show_move_moves_the_sliders(cube):
+    viewer = LayerViewer(cube)
+    path = viewer.path
+    target = int(path.group_move[40] + 7)
+    viewer.show_move(target)
+    assert viewer.layers.value[1] == 40 and viewer.moves.value == 7 and viewer.current_move == target
+
+
+@pytest.mark.parametrize("source, says", [
+    ("", "empty"),
+    ("G21 G90\nM2\n", "no motions"),
+    ("/no/such/program.gcode", "no such program file"),
+])
+def test_bad_input_is_a_message_not_a_traceback(source, says):
+    for widget in (LayerViewer(source), VelocityPlot(source)):
+        assert says in widget.error and says in repr(widget)
+        assert says in widget.widget.children[0].value  # the message box is what the widget shows
+        assert widget.screenshot().shape[2] == 3
+        assert widget._repr_mimebundle_()["image/png"].startswith(b"\x89PNG")
+
+
+# -- VelocityPlot ------------------------------------------------------------------------
+
+
+def test_velocity_envelope_keeps_each_bins_extremes(cube):
+    plot = VelocityPlot(cube)
+    x0, x1 = plot.xs[0], plot.xs[-1]
+    p = plot.points(x0, x1, bins=300)
+    assert p["mode"] == "binned" and p["x"].size <= 300
+    # an independent binning of the full profile gives the same highest speed per bin
+    edges = np.linspace(x0, x1, 301)
+    k = 137
+    inside = (plot.xs >= edges[k]) & (plot.xs < edges[k + 1])
+    j = np.searchsorted(p["x"], plot.xs[inside][0])
+    assert p["hi"][j] == pytest.approx(plot.planned[inside].max())
+    assert p["lo"][j] == pytest.approx(plot.planned[inside].min())
+    raw = plot.points(x0, x0 + (x1 - x0) / 5000)
+    assert raw["mode"] == "raw"  # every corner, from the first move's first corner on
+    np.testing.assert_array_equal(raw["x"], plot.xs[:raw["x"].size])
+
+
+def test_linked_plot_follows_the_viewers_range(cube):
+    viewer = LayerViewer(cube)
+    plot = VelocityPlot(cube).link(viewer)
+    viewer.layers.value = (12, 12)
+    w = cube.waypoints
+    rows = np.flatnonzero((waypoint_layers(cube) == 12) & (w["motion"] > 0) & (w["distance"] > 0))
+    end = cube.elapsed_time()
+    assert plot.range == pytest.approx((end[rows[0]] - w["time"][rows[0]], end[rows[-1]]))
+    viewer.moves.value = 3
+    assert plot.range[1] == pytest.approx(end[rows[3]])
+    plot.view.picked = [int(viewer.path.group_move[30]), 0, 0.0]  # a point clicked in the plot
+    assert viewer.layers.value[1] == 30 and viewer.moves.value == 0
+    assert "move" in plot.picked.value
+
+
+def test_velocity_over_distance(cube):
+    plot = VelocityPlot(cube, layers=(2, 2), x="distance")
+    assert plot.view.x_label == "distance (mm)" and plot.range[1] > plot.range[0]
+    assert plot.screenshot().shape == (300, 900, 3)
+
+
+# -- StageDiff ---------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def comp_diff():
+    return StageDiff(PROGRAMS / "comp.ngc", a=0, b=6, tool_table=PROGRAMS / "tools.tbl")
+
+
+def test_stages_line_up_by_source_line(comp_diff):
+    rows = comp_diff.rows()
+    a, b = comp_diff.sides()
+    changed = [(a.lines[i], b.lines[j]) for status, i, j in rows if status == "changed"]
+    # G1 X40 (line 10) in G54 moved to machine X50, cut 3 mm inside: the tool centre at X87 (by hand)
+    assert ("N10 G1 X40", "N10 G1 X87 Y23 Z-1 F400") in changed
+    html = comp_diff.diff_html()
+    assert 'class="changed"' in html and "G1 X40" in html and "G10 L2 P1 X50 Y20 Z0" in html
+
+
+def test_stages_are_drawn_as_written(comp_diff):
+    written = comp_diff._operation(comp_diff.sides()[0], 0)
+    machine = comp_diff._operation(comp_diff.sides()[1], 1)
+    feed = lambda op: op.waypoints["x"][op.waypoints["motion"] == 2]  # noqa: E731
+    assert feed(written).max() == pytest.approx(40.0)  # program coordinates, programmed path
+    assert feed(machine).max() == pytest.approx(50 + 40 - 3)  # G54 origin X50, 3 mm tool radius inside
+    comp_diff.stage_a.value = 6
+    assert "0 changed, 0 only left, 0 only right" in comp_diff.diff_html()
+    assert bytes(comp_diff.image.value).startswith(b"\x89PNG")
+    comp_diff.stage_a.value = 0
+
+
+def test_two_programs(tmp_path):
+    edited = tmp_path / "bracket_edited.ngc"
+    lines = MILL.read_text().splitlines()
+    k = lines.index("G1 X65 F900")
+    lines[k] = "G1 X60 F900"
+    edited.write_text("\n".join(lines) + "\n")
+    diff = StageDiff.programs(MILL, edited)
+    changed = [(status, i, j) for status, i, j in diff.rows() if status != "same"]
+    assert changed == [("changed", k, k)]
+    assert "G1 X60 F900" in diff.diff_html()
+
+
+def test_a_stage_that_fails_is_a_message(monkeypatch):
+    from gcodekit.transpile import Transpiler
+
+    stage = Transpiler.stage
+
+    def failing(self, k):
+        if k == 5:
+            raise ValueError("cutter compensation: the tool is larger than the arc")
+        return stage(self, k)
+
+    monkeypatch.setattr(Transpiler, "stage", failing)
+    diff = StageDiff(MILL, a=0, b=5)
+    assert "stage 5 could not be translated: cutter compensation" in diff.diff_html()
+    assert diff.screenshot().shape[2] == 3
+    diff.stage_b.value = 6  # the other stages still work
+    assert "could not" not in diff.diff_html()
+    assert "no motions" in StageDiff("G21\nM2\n").error
+
+
+# -- worksheet checks ------------------------------------------------------------------
+
+
+def test_checks():
+    assert check((110, 50, 24), (110.0, 50.0, 24.0)).ok is True
+    assert check((110, 50), (110.0, 50.0, 24.0)).ok is False
+    assert check("Planned", "planned").ok is True
+    assert check(None, 1.0).ok is None
+    assert "Hint: add" in check(3, 4, hint="add").message
