@@ -592,3 +592,11 @@ def test_standalone_canon_aims_g28_and_g53_with_the_stale_tool_offset(tmp_path):
     np.testing.assert_allclose(standalone.motions()["z"].to_numpy(), [0.0, -2.44, 0.5 - 2.44], atol=1e-9)
     machine = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, tool_table=table, tool_table_units="inch")
     np.testing.assert_allclose(machine.motions()["z"].to_numpy(), [0.0, 0.0, 0.5], atol=1e-9)
+
+
+def test_standalone_canon_stores_g28_home_with_the_held_tool_offset():
+    """G28.1 stores the machine point rs274 works out (program point plus offsets plus the tool offset it
+    holds, stale after G20/G21), so a G28 right after it goes nowhere (rs274 2.9 prints the same)."""
+    text = "G20\nG43.1 X0.06487 Z-0.30651\nG21\nG28.1\nG28\nM2\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, standalone_canon=True)
+    np.testing.assert_allclose(op.motions()[["x", "y", "z"]].to_numpy(), np.zeros((2, 3)), atol=1e-9)

@@ -458,6 +458,11 @@ class Machine:
                                         f"{arcs.PLANE_NAMES[s.plane]} plane", kind="machine")
         if self.rs274_blocks and not np.isnan(r_word).all():
             self._check_radius_ends(t, rows, ~np.isnan(r_word), p0, p1, "XYZ"[f] + "XYZ"[g])
+        if self.rs274_blocks and not s.arc_incremental:  # G90.1: rs274 wants both centre words
+            for letter, offsets in ((l1, o1), (l2, o2)):
+                for i in np.flatnonzero(np.isnan(r_word) & np.isnan(offsets))[:20]:
+                    self.diagnostics.report(int(t.line[rows[i]]), 1, f"{letter} word missing in absolute center arc",
+                                            kind="machine")
         no_center = np.isnan(r_word) & np.isnan(o1) & np.isnan(o2)
         for i in np.flatnonzero(no_center)[:20]:
             self.diagnostics.report(int(t.line[rows[i]]), 1, f"arc needs {l1}/{l2} offsets or R in this plane (G{s.plane})",

@@ -198,10 +198,13 @@ class ModalHandler:
             work_systems.restore_axis_offset(s)
         elif name in ("home", "home_secondary"):
             motion, extra = MOTION_RAPID, self._home(params, name == "home_secondary")
-        elif name == "store_home":
-            s.home = s.position.copy()
-        elif name == "store_home_secondary":
-            s.home_secondary = s.position.copy()
+        elif name in ("store_home", "store_home_secondary"):
+            # the machine point as the interpreter works it out, with the tool offset it holds
+            stored = s.position + self._tool_offset_held() - s.tool_offset
+            if name == "store_home":
+                s.home = stored
+            else:
+                s.home_secondary = stored
         elif name == "machine_coordinates":
             motion = self._machine_move(params, int(t.motion[row]), line)
         elif name == "set_flow":
