@@ -34,7 +34,7 @@ from .parse import CommandTable, GcodeParser
 from .parse.table import NAME_ID
 from .read import CHUNK_LINES, Blocks, iter_blocks, iter_lines, iter_source_blocks, read_source_lines
 from .read.percent import until_closing_percent
-from .syntax import Flavor, detect_flavor, load_flavor
+from .syntax import Detection, Flavor, detect_flavor, load_flavor
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -87,38 +87,46 @@ def as_program(source: str | os.PathLike) -> Program:
 
 
 def resolve(program: Program, machine: str | MachineConfig | None, flavor: str | Flavor | None,
-            **machine_options) -> tuple[Flavor, MachineConfig, str]:
+            **machine_options) -> tuple[Flavor, MachineConfig, Detection | None]:
     """Choose flavor and machine: explicit ones first, else detection.
 
-    Returns the flavor, the machine and a sentence saying how the flavor was
-    chosen.
+    Returns the flavor, the machine and the detection (None when the flavor
+    was given or came with the machine).
     """
     config = None
     if isinstance(machine, MachineConfig):
         config = machine
     elif machine is not None:
         config = load_machine(machine)
+    detection = None
     if flavor is not None:
         fl = load_flavor(flavor) if isinstance(flavor, (str, os.PathLike)) else flavor
-        how = "given"
     elif config is not None:
-        fl, how = load_flavor(config.flavor), f"from machine {config.name}"
+        fl = load_flavor(config.flavor)
     else:
         detection = detect_flavor(program.head(), program.name if program.path else None)
-        fl, how = load_flavor(detection.name), "detected: " + "; ".join(detection.reasons)
+        fl = load_flavor(detection.name)
     if config is None:
         config = load_machine(default_machine_for(fl.name))
     if machine_options:
         config = with_options(config, **machine_options)
-    return fl, config, how
+    return fl, config, detection
+
+
+def _note_weak_detection(detection: Detection | None, diagnostics: Diagnostics) -> None:
+    """An info diagnostic naming the flavor detection chose, and why, when its evidence was thin."""
+    if detection is not None and detection.weak:
+        diagnostics.report(1, 1, f"flavor {detection.name!r} chosen on thin evidence ({'; '.join(detection.reasons)}); "
+                           "give the flavor (flavor=, --flavor) if the program is in another dialect", severity="info")
 
 
 def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None, *,
                   mode: str = "lenient") -> Operation:
     """Read and parse a program without emulating it (no process data yet)."""
     program = as_program(source)
-    fl, config, _ = resolve(program, None, flavor)
+    fl, config, detection = resolve(program, None, flavor)
     diagnostics = Diagnostics(program.name, mode)
+    _note_weak_detection(detection, diagnostics)
     parser = GcodeParser(fl, diagnostics)
     parts, n_lines = [], 0
     for blocks, lines in _blocks(program, fl, diagnostics):
@@ -188,7 +196,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     check_choice("mode", mode, ("lenient", "strict"))
     limits = Limits(max_motions, max_iterations)
     program = as_program(source)
-    fl, config, _ = resolve(program, machine, flavor, **machine_options)
+    fl, config, detection = resolve(program, machine, flavor, **machine_options)
     if machine_config is not None:
         if not config.planner:
             raise ConfigError(f"machine {config.name!r} has no planner to read {os.fspath(machine_config)!r}")
@@ -196,6 +204,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
 
         config = dataclasses.replace(config, **firmware_options(config.planner, machine_config))
     diagnostics = Diagnostics(program.name, mode)
+    _note_weak_detection(detection, diagnostics)
     parser = GcodeParser(fl, diagnostics)
     # strict mode raises the machine's first error once the program has run (see _raise_first_run)
     machine_diagnostics = Diagnostics(program.name, "lenient") if mode == "strict" else diagnostics
@@ -216,7 +225,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     reading_error = None
     try:
         for blocks, lines in _blocks(program, fl, diagnostics, bar, machine=(m, emulate), limits=limits,
-                                     search_path=config.subroutine_path + (m.ini.subroutine_path if m.ini else ())):
+                                     search_path=config.subroutine_path + (m.ini.subroutine_path if m.ini else ()),
+                                     fanuc_subs=m.ini.fanuc_subs if m.ini else True):
             emulate(blocks, lines)
     except GcodeError as exc:  # strict mode: raised below unless a line run before it failed
         reading_error = exc
@@ -261,7 +271,8 @@ def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineCon
 
 def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None,
             machine: tuple[Machine, Callable[[Blocks, int], None]] | None = None,
-            search_path: Sequence[str] = (), limits: Limits = Limits()) -> Iterator[tuple[Blocks, int]]:
+            search_path: Sequence[str] = (), limits: Limits = Limits(),
+            fanuc_subs: bool = True) -> Iterator[tuple[Blocks, int]]:
     """Blocks of the program chunk by chunk, preprocessed when it needs it.
 
     With ``machine`` (the machine and a function that parses and emulates
@@ -281,7 +292,8 @@ def _blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None
         # (until a probe goes by, the watch only collects the lines)
         feedback = _MachineFeedback(flavor, diagnostics, *machine) if machine is not None else None
         store = ParameterStore(system=feedback.system, system_writes=feedback) if feedback is not None else None
-        stages = [ControlFlowStage(flavor, store, search_path=search_path, max_iterations=limits.max_iterations,
+        stages = [ControlFlowStage(flavor, store, search_path=search_path, fanuc_subs=fanuc_subs,
+                                   max_iterations=limits.max_iterations,
                                    max_motions=limits.max_motions)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text) or _SUBPROGRAM_M.search(text)) else []
         if not stages:

@@ -2,6 +2,6 @@
 # The test suite: unit, golden and property tests plus the doctests.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-source "$ROOT/scripts/setup.sh"
+GCODEKIT_SETUP_RS274=1 source "$ROOT/scripts/setup.sh"
 cd "$ROOT"
 exec "$VENV/bin/python" -m pytest tests gcodekit --doctest-modules "$@"

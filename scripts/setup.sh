@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Create .venv and install gcodekit with its test and report tools, once per
 # change of pyproject.toml; install Chromium (PDF reports) and poppler-utils
-# (the PDF test) with apt-get when missing.  Sourced by run-examples.sh and
-# run-tests.sh.
+# (the PDF test) with apt-get when missing, and for the tests LinuxCNC's rs274
+# (the differential check against it).  Sourced by run-examples.sh and
+# run-tests.sh (which sets GCODEKIT_SETUP_RS274=1).
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 VENV="$ROOT/.venv"
@@ -43,6 +44,19 @@ if [ ${#missing[@]} -gt 0 ]; then
       || die "apt-get could not install ${missing[*]}"
   else
     die "pictures and PDF reports need ${missing[*]}: install them (apt-get install ${missing[*]}) as root, then run this again"
+  fi
+fi
+
+# LinuxCNC's standalone interpreter rs274 (Debian package linuxcnc-uspace) is the reference the
+# differential tests run against; without it they skip, so only the test command asks for it.
+if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -x /usr/bin/rs274 ]; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    echo "gcodekit setup: installing linuxcnc-uspace (LinuxCNC's rs274) with apt-get" >&2
+    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+        linuxcnc-uspace >/dev/null; } \
+      || die "apt-get could not install linuxcnc-uspace (LinuxCNC's rs274, the reference of the differential tests)"
+  else
+    die "the differential tests need LinuxCNC's rs274: install it as root (apt-get install --no-install-recommends linuxcnc-uspace), then run this again"
   fi
 fi
 

@@ -30,6 +30,12 @@ CENTRE = ["cx", "cy", "cz"]
 CANON_MOTION = {"STRAIGHT_TRAVERSE": "rapid", "STRAIGHT_FEED": "feed", "STRAIGHT_PROBE": "feed",
                 "NURBS_FEED": "spline"}
 SPLINES = [NAME_ID[n] for n in ("spline_cubic", "spline_quadratic", "nurbs_end")]
+#: gcodekit's LinuxCNC machine as rs274 run standalone behaves: it reads tool tables in inches,
+#: and its canon hands back the F number and the tool offset's numbers when G20/G21 change the
+#: units (``F30 G20`` is 30 in/min there, 30 mm/min in LinuxCNC's task) and the last move's
+#: program point after M6 (see MachineConfig.standalone_canon)
+RS274_STANDALONE = {"machine": "linuxcnc", "tool_table_units": "inch", "units_keep_feed": True,
+                    "standalone_canon": True}
 
 
 def to_machine(x: np.ndarray, y: np.ndarray, z: np.ndarray,
@@ -39,14 +45,18 @@ def to_machine(x: np.ndarray, y: np.ndarray, z: np.ndarray,
     angle = np.radians(ref["xy_rot"])
     cos, sin = np.cos(angle), np.sin(angle)
     mx = px * cos - py * sin + ref["g5x_x"] + ref["tlo_x"]
-    my = px * sin + py * cos + ref["g5x_y"]
+    my = px * sin + py * cos + ref["g5x_y"] + (ref["tlo_y"] if "tlo_y" in ref else 0.0)  # G43.1 Y
     mz = z + ref["g92_z"] + ref["g5x_z"] + ref["tlo_z"]
     return mx.to_numpy(), my.to_numpy(), mz.to_numpy()
 
 
 def reference_motions(csv_path: Path) -> pd.DataFrame:
     """A ``.canon.csv`` as a table shaped like :meth:`Operation.motions`."""
-    ref = pd.read_csv(csv_path, keep_default_na=False, na_values=[""])
+    return reference_table(pd.read_csv(csv_path, keep_default_na=False, na_values=[""]))
+
+
+def reference_table(ref: pd.DataFrame) -> pd.DataFrame:
+    """Canon rows (the ``.canon.csv`` columns, blanks as NaN) as a table shaped like :meth:`Operation.motions`."""
     motion = ref["type"].map(CANON_MOTION)
     arc = ref["type"] == "ARC_FEED"
     motion[arc] = np.where(ref.loc[arc, "arc_rotation"] < 0, "arc_cw", "arc_ccw")
@@ -67,11 +77,11 @@ def reference_motions(csv_path: Path) -> pd.DataFrame:
 
 
 def first_difference(ours: pd.DataFrame, ref: pd.DataFrame, exact: list[str],
-                     close: list[str]) -> str | None:
+                     close: list[str], atol: "float | np.ndarray" = ATOL) -> str | None:
     """Describe the first row where the tables differ, or None.
 
     ``exact`` columns must be equal; ``close`` columns must agree within
-    ATOL + RTOL * |reference| wherever the reference has a value.
+    ``atol`` (a number, or one per row) + RTOL * |reference| wherever the reference has a value.
     """
     n = min(len(ours), len(ref))
     a, b = ours.iloc[:n].reset_index(drop=True), ref.iloc[:n].reset_index(drop=True)
@@ -80,7 +90,7 @@ def first_difference(ours: pd.DataFrame, ref: pd.DataFrame, exact: list[str],
         bad[key] = a[key].to_numpy() != b[key].to_numpy()
     for key in close:
         want, got = b[key].to_numpy(float), a[key].to_numpy(float)
-        ok = np.abs(got - want) <= ATOL + RTOL * np.abs(want)
+        ok = np.abs(got - want) <= atol + RTOL * np.abs(want)
         bad[key] = ~np.isnan(want) & ~ok
     rows = np.flatnonzero(bad.to_numpy().any(axis=1))
     if len(rows) == 0:
@@ -135,10 +145,7 @@ def ours_like_canon(op) -> pd.DataFrame:
 @cache
 def motions(name: str) -> tuple[pd.DataFrame, pd.DataFrame, list]:
     """(our motions, reference motions, diagnostics) of one case."""
-    # rs274 standalone reads tables in inches, and its canon hands back the F number when
-    # G20/G21 re-read the feed (``F30 G20`` is 30 in/min there, 30 mm/min in LinuxCNC's task)
-    op = gcodekit.gcode_to_operation(CASES / name, machine="linuxcnc", plan=False, tool_table=tool_table(name),
-                                     tool_table_units="inch", units_keep_feed=True)
+    op = gcodekit.gcode_to_operation(CASES / name, plan=False, tool_table=tool_table(name), **RS274_STANDALONE)
     return ours_like_canon(op), reference_motions(CASES / (name + ".canon.csv")), op.diagnostics.items
 
 

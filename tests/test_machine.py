@@ -578,3 +578,25 @@ def test_one_warning_for_every_tool_without_a_table():
     assert [d.severity for d in op.diagnostics] == ["warning"]
     printer = gcodekit.gcode_to_operation("T1\nG1 X1 E1 F100\nT0\n", "marlin", plan=False)
     assert not printer.diagnostics.items  # extruders need no table
+
+
+def test_standalone_canon_aims_g28_and_g53_with_the_stale_tool_offset(tmp_path):
+    """rs274 alone keeps a tool offset's number across G20/G21: G43 H2 in mm holds 2.54, read as
+    2.54 in after G20, so G28 aims at home less 2.54 in and the machine's real 0.1 in offset
+    puts the tool at -2.44 in (worked out by hand; rs274 2.9 prints the same)."""
+    table = tmp_path / "tools.tbl"
+    table.write_text("T2 P2 Z0.1\n")
+    text = "G21\nG43 H2\nG20\nG28\nG53 G0 Z0.5\nM2\n"
+    standalone = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, tool_table=table, tool_table_units="inch",
+                                             standalone_canon=True)
+    np.testing.assert_allclose(standalone.motions()["z"].to_numpy(), [0.0, -2.44, 0.5 - 2.44], atol=1e-9)
+    machine = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, tool_table=table, tool_table_units="inch")
+    np.testing.assert_allclose(machine.motions()["z"].to_numpy(), [0.0, 0.0, 0.5], atol=1e-9)
+
+
+def test_standalone_canon_stores_g28_home_with_the_held_tool_offset():
+    """G28.1 stores the machine point rs274 works out (program point plus offsets plus the tool offset it
+    holds, stale after G20/G21), so a G28 right after it goes nowhere (rs274 2.9 prints the same)."""
+    text = "G20\nG43.1 X0.06487 Z-0.30651\nG21\nG28.1\nG28\nM2\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, standalone_canon=True)
+    np.testing.assert_allclose(op.motions()[["x", "y", "z"]].to_numpy(), np.zeros((2, 3)), atol=1e-9)

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import gcodekit
 from gcodekit.errors import ConfigError
 from gcodekit.syntax import (
     BLOCK_SPLITS,
@@ -210,3 +211,51 @@ def test_detect_fallback(head, filename, expected):
 def test_detect_never_raises(text, filename):
     detection = detect_flavor(text, filename)
     assert detection.name in FLAVORS
+
+
+# LinuxCNC's tests/interp/m98m99/01-basics: Fanuc-style subprograms in a .ngc file with ';' comments
+M98_NGC = ("%\n( A simple O sub example )\n\nF40\nG90 G0 X0 Y0 Z0.25\nM98 P1 L3\nM30\n\nO1\n"
+           "G91 G0 X1                ; Jog 1\" along X (relative)\nG90 G99 G81 Z-1.0 R0.25  ; Drill to Z-1.0\nM99\n%\n")
+
+
+def test_detect_weighs_the_extension_and_linuxcnc_syntax_over_fanuc_subprograms():
+    detection = detect_flavor(M98_NGC, "test.ngc")  # .ngc is LinuxCNC's alone, and LinuxCNC runs M98/M99
+    assert (detection.name, detection.weak) == ("rs274ngc", False)
+    as_nc = detect_flavor(M98_NGC, "test.nc")  # '.nc' is shared; words after ';' are no Fanuc block
+    assert as_nc.name == "rs274ngc" and as_nc.weak and dict(as_nc.candidates).get("fanuc", 0) < 3
+    fanuc = "%\nO1234 (BRACKET)\nG21 G17 G90\nM98 P2000\nM30\n%\n"
+    assert detect_flavor(fanuc, "part.nc").name == "fanuc"
+
+
+def test_detect_named_linuxcnc_syntax_beats_a_program_number():
+    text = "O0100 (FANUC-LIKE NUMBER)\n#<depth> = 2\nG0 Z[#<depth> + 1]\nM98 P2\nM30\n"
+    assert detect_flavor(text, "part.nc").name == "rs274ngc"
+
+
+def test_weak_detection_is_an_info_diagnostic_naming_the_flavor_and_why(tmp_path):
+    weak = tmp_path / "part.nc"
+    weak.write_text("G21 G90\nG0 X1 Y2\nG1 X3 F100\nM2\n")
+    infos = [d for d in gcodekit.gcode_to_operation(weak, plan=False).diagnostics.items if d.severity == "info"]
+    assert len(infos) == 1 and infos[0].line == 1
+    assert "'rs274ngc'" in infos[0].message and "default" in infos[0].message
+    strong = tmp_path / "part.ngc"
+    strong.write_text(M98_NGC)
+    op = gcodekit.gcode_to_operation(strong, plan=False, tool_table_units="inch")
+    assert not [d for d in op.diagnostics.items if d.severity == "info"]
+    assert op.flavor.name == "rs274ngc" and len(op.motions()) == 13  # rs274's 13 motions (LinuxCNC's expected)
+    given = gcodekit.gcode_to_operation(weak, flavor="rs274ngc", plan=False)
+    assert not [d for d in given.diagnostics.items if d.severity == "info"]
+
+
+def test_ini_disabling_fanuc_subprograms_refuses_m98(tmp_path):
+    """LinuxCNC's tests/interp/m98m99/09-disable-fanuc-subs: rs274 stops at the M98 (line 6)."""
+    program, ini = tmp_path / "test-fanuc.ngc", tmp_path / "test-no-fanuc.ini"
+    program.write_text(M98_NGC)
+    ini.write_text("[RS274NGC]\nDISABLE_FANUC_STYLE_SUB = 1\n[EMC]\nDEBUG = 2147483647\n")
+    op = gcodekit.gcode_to_operation(program, plan=False, ini_file=str(ini))
+    errors = [d for d in op.diagnostics.items if d.severity == "error"]
+    assert [(d.line, d.message) for d in errors] == [(6, "DISABLE_FANUC_STYLE_SUB set in INI file, but found m98")]
+    assert len(op.motions()) == 1  # the G0 before it, as rs274's canon has
+    allowed = tmp_path / "test-fanuc.ini"
+    allowed.write_text("[RS274NGC]\nDISABLE_FANUC_STYLE_SUB = 0\n")
+    assert len(gcodekit.gcode_to_operation(program, plan=False, ini_file=str(allowed)).motions()) == 13

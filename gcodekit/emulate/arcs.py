@@ -18,6 +18,7 @@ PLANES = {
     19: ((1, 2, 0), ("J", "K")),
 }
 PLANE_CODES = (17, 18, 19)
+PLANE_NAMES = {17: "xy", 18: "xz", 19: "yz"}  # as rs274's messages name them
 TWO_PI = 2.0 * np.pi
 
 

@@ -30,7 +30,12 @@ tool off it by the tool radius, after the rules of LinuxCNC's interpreter
   end of that feed to the corner as well, so its arc ends where it starts:
   gcodekit keeps the arc, matching rs274 only when the next move is tangent);
 * gouges are errors, as in rs274: an offset line that would run backwards
-  between its corners, or an inside corner whose offset paths never meet;
+  between its corners, an inside corner whose offset paths never meet, or
+  a queued arc whose end, moved to the next corner or to where G40 finds
+  the tool, lies further round than the programmed arc turns (beyond
+  rs274's tolerance, radians compared with 0.001 in G20 and 0.0254 in G21:
+  an arc met nearly tangentially starts where the tool is, which can be
+  enough);
 * a G70 under compensation inherits a quirk of rs274's: reading the profile
   leaves rs274's current point on the profile's last point, so the cycle's
   first rapid (to where the programmed point already is) takes the tool
@@ -89,6 +94,7 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
     pending = None  # index in `out` of the previous compensated waypoint
     staying: list[int] = []  # later rows that end where `pending` does (no move in the plane)
     pending_start, pending_dir = None, None  # where it starts and, for a line, its programmed direction
+    pending_arc = None  # for an arc: (centre, ccw, programmed sweep) in the plane
     side_rows = {int(r): _SIDES[int(t.name[r])] for r in np.flatnonzero(np.isin(t.name, list(_SIDES)))}
     tool_changes = set(np.flatnonzero(t.name == NAME_ID["tool_change"]).tolist())
     held: dict[str, float] = {}  # plane axes rs274 re-read from the tool after an M6 (see below)
@@ -129,6 +135,9 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
                         lathe = _lathe_shift(orientation, radius) if plane == 18 else (0.0, 0.0)
                     elif not new and side:
                         side, mode = 0, "exit"
+                        if pending_arc is not None and out["x"] and _arc_grows(
+                                pending_arc, pending_start, np.array([out[a][-1], out[b][-1]]), columns["units"][k]):
+                            op.diagnostics.report(int(t.line[r]), 1, _ARC_GOUGE, kind="machine")
                 if r in tool_changes and mode == "exit" and out["x"]:
                     # rs274 re-reads its position after M6: the program position becomes
                     # the compensated one, so the exit starts from there (useful-subroutines.ngc)
@@ -143,7 +152,7 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
             changes = dict(held)
             if mode == "exit" and motion:
                 mode, last_dir, last_corner, pending, last_path = "off", None, None, None, None
-                pending_start, pending_dir = None, None
+                pending_start, pending_dir, pending_arc = None, None, None
             emit(k, **changes)
             continue
         if mode == "off" or radius <= 0:
@@ -160,7 +169,7 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
             moved = (0.0, 0.0)
             emit(k)  # straight from the compensated point to the programmed end
             mode, last_dir, last_corner, pending, last_path = "off", None, None, None, None
-            pending_start, pending_dir = None, None
+            pending_start, pending_dir, pending_arc = None, None, None
             continue
         if mode == "on" and nth == 1 and profile_ends and profile_ends[0][0] == int(t.line[row]) \
                 and int(t.name[row]) == NAME_ID["lathe_finish"]:
@@ -220,7 +229,7 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
                            "cx": np.nan, "cy": np.nan, "cz": np.nan, "distance": length, "de": 0.0,
                            "time": length / (feed / 60.0) if feed > 0 else 0.0})
             pending, staying = emit(k, **{a: new_end[0], b: new_end[1], ca: entry_center[0], cb: entry_center[1]}), []
-            pending_start, pending_dir = start, None
+            pending_start, pending_dir, pending_arc = start, None, None
             mode, last_dir, last_corner = "on", out_dir, end
             last_path = ("arc", entry_center, float(np.hypot(*(new_end - entry_center))), ccw, grow < 0)
             continue
@@ -229,7 +238,7 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
             shifted = end + _left(_unit(chord)) * side * radius
             moved = lathe
             pending, staying = emit(k, **{a: shifted[0], b: shifted[1]}), []
-            pending_start, pending_dir = start, _unit(chord)
+            pending_start, pending_dir, pending_arc = start, _unit(chord), None
             mode, last_dir, last_corner = "on", _unit(chord), end
             last_path = ("line", shifted, _unit(chord))
             continue
@@ -280,12 +289,14 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
                 elif last_path[0] == "line":
                     heading = math.atan2(*(start - programmed_start)[::-1]) - side * math.pi / 2
                     meet = _line_to_arc_corner(heading, beta, this_path, r1, radius)
-                    problem = "Arc move in concave corner cannot be reached by the tool without gouging"
+                    problem = _ARC_GOUGE
                 elif not arc:
                     meet = _arc_to_line_corner(last_path, programmed_start, math.atan2(in_dir[1], in_dir[0]), radius)
                 else:
                     meet = _arc_to_arc_corner(last_path, this_path)
                 if meet is not None:
+                    if pending_arc is not None and _arc_grows(pending_arc, pending_start, meet, columns["units"][k]):
+                        op.diagnostics.report(int(t.line[row]), 1, _ARC_GOUGE, kind="machine")
                     for r in (pending, *staying):
                         out[a][r], out[b][r] = meet[0], meet[1]
                     new_start = meet
@@ -299,7 +310,13 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
                                       "the tool without gouging", kind="machine")
         centre = (columns[ca][k], columns[cb][k]) if motion in (MOTION_CW, MOTION_CCW) else (np.nan, np.nan)
         pending, staying = emit(k, **{a: new_end[0], b: new_end[1], ca: centre[0], cb: centre[1]}), []
-        pending_start, pending_dir = new_start, (None if motion in (MOTION_CW, MOTION_CCW) else in_dir)
+        if arc:  # rs274's queue holds it from where the tool starts it (the corner's end, or where the tool is)
+            arc_from = new_start if gap > _TINY and (inside or beta > CONCAVE_CORNER) else start
+            pending_arc = (center, ccw, _turn(programmed_start, center, ccw, end))
+            pending_start, pending_dir = arc_from, None
+        else:
+            pending_arc = None
+            pending_start, pending_dir = new_start, in_dir
         last_dir, last_corner, last_path = out_dir, end, this_path
     for i, da, db, plane in lathe_rows:
         (f, g, _), _ = PLANES[plane]
@@ -309,6 +326,30 @@ def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]
     for key in columns:
         w[key] = np.asarray(out[key], dtype=columns[key].dtype)
     _recompute_lengths(w)
+
+
+_ARC_GOUGE = "Arc move in concave corner cannot be reached by the tool without gouging"
+
+
+def _turn(start: np.ndarray, centre: np.ndarray, ccw: bool, end: np.ndarray) -> float:
+    """The angle (radians, signed as the arc turns) from ``start`` to ``end`` about ``centre``, less than
+    a full turn (rs274's ``find_turn`` for one turn).
+
+    >>> round(_turn(np.array([1.0, 0]), np.zeros(2), True, np.array([0, 1.0])), 6)
+    1.570796
+    """
+    alpha = math.atan2(*(start - centre)[::-1])
+    beta = math.atan2(*(end - centre)[::-1])
+    if ccw:
+        return beta - alpha + (2 * math.pi if beta <= alpha else 0.0)
+    return beta - alpha - (2 * math.pi if alpha <= beta else 0.0)
+
+
+def _arc_grows(arc: tuple, start: np.ndarray, end: np.ndarray, inch: int) -> bool:
+    """Whether a queued arc from ``start`` with its end moved to ``end`` turns further than programmed
+    (rs274's ``move_endpoint_and_flush``, whose tolerance compares radians with 0.001 in or 0.0254 mm)."""
+    centre, ccw, sweep = arc
+    return abs(_turn(start, centre, ccw, end)) > abs(sweep) + (0.001 if inch == 1 else 0.0254)
 
 
 def _lathe_shift(orientation: int, radius: float) -> tuple[float, float]:

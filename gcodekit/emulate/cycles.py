@@ -5,24 +5,32 @@ Follows LinuxCNC 2.9's interpreter (interp_cycles.cc and the G-code manual):
 * The cycle's plane picks the drilling axis (Z for G17, Y for G18, X for
   G19); "Z" below means that axis, "XY" the two others.
 * R, Z, P and Q stay in force while the cycle mode lasts; a later block with
-  only X/Y drills again at the new place.
+  only X/Y drills again at the new place.  A block that starts a cycle (the
+  mode was another one, or none) must give R, Z and the cycle's own P, Q or
+  I/J/K again, and R may not be below Z.
 * The "old Z" of every block is the level where the cycle mode began (rs274's
-  ``cycle_il``), kept until G80 or another motion mode ends it.
+  ``cycle_il``, one number: after a plane change it is still the level of
+  the old drilling axis), kept until G80 or another motion mode ends it.
 * Absolute mode: R and Z are coordinates.  Incremental mode (G91): R is
   measured from the old Z, Z from R, and X/Y are increments repeated L times.
 * If the old Z is below R, every block first rapids up to R where the tool
-  is (a zero-length move once it is there).  At each hole: rapid over the
-  hole (even when already there; under G98 at the clear height), rapid down to R if above it, the cycle's
-  own moves, then a rapid retract to the clear height: the old Z (G98, if
-  that is above R) or R (G99).
+  is (a zero-length move once it is there).  At the first hole, if the tool
+  is above R: rapid over the hole at its level, then down to R.  Otherwise,
+  and at every repeat: rapid over the hole at the clear height (from below
+  it, a slanted move), then down to R if the clear height is above it.  Then
+  the cycle's own moves, ending at the clear height: the old Z (G98, if that
+  is above R) or R (G99).  rs274 2.9 emits every one of these moves, zero
+  length or not.
 * G84 and G74 feed out again (the spindle reversed).  Outside G17 rs274 2.9
   sends these two feeds with the axes mixed up: in G18 to (level, hole Z,
   hole X), in G19 to (hole Z, level, hole Y) as X Y Z (LinuxCNC's own
   tests/interp g84 output keeps it); gcodekit moves the same way, and
   rs274's idea of where the tool is afterwards stays the right one
   (:attr:`CycleMoves.end`).
-* G88 stops at the bottom for a
-  manual retract, so the cycle itself never leaves the hole; G87 steps aside
+* G85 feeds back to R, then rapids to the clear height; G89 dwells and feeds
+  all the way to it.  G88 stops at the bottom for a
+  manual retract, so the cycle itself never leaves the hole (rs274 takes the
+  tool to be at the clear height afterwards); G87 steps aside
   by I/J, drops below the part, bores up to K (G91: K from Z) and back, then
   leaves the way it came.
 * G83 pecks Q deeper each time, rapids back to R, then rapids back down to
@@ -43,7 +51,7 @@ import numpy as np
 
 from ..limits import MotionBudget
 from ..parse.table import CYCLE_NAMES, MOTION_LINEAR, MOTION_RAPID
-from .arcs import PLANES
+from .arcs import PLANE_NAMES, PLANES
 
 CYCLES = frozenset(CYCLE_NAMES)
 PECK_DELTA_MM = 0.254  # LinuxCNC's G73/G83 back-off and approach, 0.010 in
@@ -81,18 +89,30 @@ class CycleState:
     shift: np.ndarray | None = None  # G87: I/J, the side step off the hole centre (mm)
     k: float | None = None  # G87: the level the back bore reaches (program mm)
     retract_to_r: bool = False  # G99
-    #: Program position when the cycle mode began (rs274's ``cycle_il``): its
-    #: drilling-axis level is the "old Z" of every block until the mode ends
-    initial: np.ndarray | None = None
+    #: Drilling-axis level (program mm) when the cycle mode began (rs274's
+    #: ``cycle_il``): the "old Z" of every block until the mode ends
+    initial: float | None = None
+
+    def keep_numbers(self, factor: float) -> None:
+        """G20/G21: rs274 2.9 keeps the cycle's numbers as they are (``convert_length_units``
+        converts none of them), so each length is now that many of the new units: times
+        ``factor``, the new units' mm over the old ones'."""
+        for name in ("r", "z", "q", "k", "initial"):
+            if getattr(self, name) is not None:
+                setattr(self, name, getattr(self, name) * factor)
+        if self.shift is not None:
+            self.shift = self.shift * factor
 
 
 def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray,
               to_machine: Callable[[np.ndarray], np.ndarray], scale: np.ndarray, plane: int, incremental: bool,
-              dwell_unit: float, budget: MotionBudget | None = None) -> CycleMoves:
+              dwell_unit: float, same_mode: bool = True, budget: MotionBudget | None = None) -> CycleMoves:
     """Moves of one canned-cycle block (``params`` as written, in program units).
 
     The cycle works in program coordinates (mm) from ``program``, the
     current point; ``to_machine`` places each of its points on the machine.
+    ``same_mode`` says the block continues the cycle mode in force (rs274's
+    ``motion_mode == motion``), so that missing words keep their old values.
     ``budget``, when given, is checked against the most moves the block can
     make before any is made (L repeats times pecks can run into billions).
 
@@ -108,6 +128,8 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
     (a, b, axis), _ = PLANES[plane]
     letter = "XYZ"[axis]
     first, second = "XYZ"[a], "XYZ"[b]
+    if not same_mode:
+        _check_new_mode_words(cycle.name, params, plane)
     if "R" in params:
         cycle.r = params["R"] * scale[axis]
         cycle.r_words = params["R"]
@@ -122,13 +144,18 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
     if cycle.r is None or cycle.z is None:
         raise ValueError(f"canned cycle needs R and {letter} (none in force)")
     repeats = int(params.get("L", 1))
+    if repeats == 0:
+        raise ValueError("Cannot do zero repeats of cycle")
     if repeats < 1:
         return CycleMoves([], program.copy())
     if cycle.initial is None:
-        cycle.initial = program.copy()
-    old = cycle.initial[axis]  # the level where the cycle mode began, program coordinates (mm)
-    r = old + cycle.r if incremental else cycle.r
+        cycle.initial = float(program[axis])
+    # levels to 1e-9 mm: rs274 compares them exactly in program units, gcodekit's pass through mm and offsets
+    old = round(cycle.initial, 9)  # the level where the cycle mode began, program coordinates (mm)
+    r = round(old + cycle.r if incremental else cycle.r, 9)
     bottom = r + cycle.z if incremental else cycle.z
+    if r < bottom:
+        raise ValueError(f"R less than {letter.lower()} in cycle in {PLANE_NAMES[plane]} plane")
     if cycle.name in ("cycle_peck", "cycle_chip_break") and not (cycle.q and cycle.q > 0):
         raise ValueError("G73/G83 need a positive Q")
     if budget is not None:
@@ -137,6 +164,7 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
     below_r = old < r
     steps: list[Step] = []
     here = program.copy()
+    level = round(here[axis], 9)  # where the tool is along the drilling axis (rs274's current_cc)
 
     def go(coord: float, motion: int, dwell: float = 0.0) -> None:
         here[axis] = coord
@@ -154,18 +182,19 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
 
     if below_r:  # preliminary move up to the R plane
         go(r, MOTION_RAPID)
+        level = r
     target = program.copy()
-    for _ in range(repeats):
+    for repeat in range(repeats):
         if "@" in params or "^" in params:
             target[[0, 1]] = polar_target(params, target[[0, 1]], scale[0], incremental)
         for ax, word in ((a, first), (b, second)):
             if word in params:
                 target[ax] = target[ax] + params[word] * scale[ax] if incremental else params[word] * scale[ax]
         here[[a, b]] = target[[a, b]]  # rs274 emits it even when already there
-        if not cycle.retract_to_r:  # G98: over the hole at the clear height (up from R after a G99 block)
-            here[axis] = clear
+        first_from_above = repeat == 0 and level > r
+        here[axis] = level if first_from_above else clear  # else over the hole at the clear height
         steps.append(Step(to_machine(here), MOTION_RAPID))
-        if here[axis] != r:
+        if first_from_above or clear > r:
             go(r, MOTION_RAPID)
         if cycle.name == "cycle_back_bore":
             _back_bore(bottom + cycle.k if incremental else cycle.k, bottom, clear, go, slide)  # G91: K from Z
@@ -174,7 +203,31 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
             tap_feed(clear)
         else:
             _drill(cycle, r, bottom, clear, go)
-    return CycleMoves(steps, here)
+    believed = here.copy()
+    if cycle.name == "cycle_bore_manual":
+        believed[axis] = clear  # rs274 sets its current point to the clear height after every cycle
+    return CycleMoves(steps, believed)
+
+
+#: The words a cycle needs in the block that starts it, besides R and the drilling axis (rs274's checks)
+_OWN_WORDS = {"cycle_drill_dwell": ("P", "G82"), "cycle_bore_stop": ("P", "G86"), "cycle_bore_manual": ("P", "G88"),
+              "cycle_bore_dwell": ("P", "G89"), "cycle_peck": ("Q", "G83"), "cycle_chip_break": ("Q", "G73")}
+
+
+def _check_new_mode_words(name: str, params: dict, plane: int) -> None:
+    """A block that starts a cycle mode gives R, the drilling axis and the cycle's own words (rs274 2.9)."""
+    (a, b, axis), _ = PLANES[plane]
+    if "R" not in params:
+        raise ValueError("R clearance plane unspecified in cycle")
+    if "XYZ"[axis] not in params:
+        raise ValueError(f"{'XYZ'[axis]} value unspecified in {PLANE_NAMES[plane]} plane canned cycle")
+    letter, code = _OWN_WORDS.get(name, ("", ""))
+    if letter and letter not in params:
+        raise ValueError(f"{'Dwell time P' if letter == 'P' else 'Q'} word missing with {code.lower()}")
+    if name == "cycle_back_bore":
+        for word in ("IJK"[a], "IJK"[b], "IJK"[axis]):
+            if word not in params:
+                raise ValueError(f"{word} word missing with g87")
 
 
 def _most_moves_per_hole(cycle: CycleState, r: float, bottom: float) -> float:
@@ -241,11 +294,13 @@ def _drill(cycle: CycleState, r: float, bottom: float, clear: float, go) -> None
         go(clear, MOTION_LINEAR)
     elif name == "cycle_bore_manual":  # G88: the operator retracts by hand after the program stop
         go(bottom, MOTION_LINEAR, cycle.p)
-    elif name in ("cycle_bore", "cycle_bore_dwell"):
-        go(bottom, MOTION_LINEAR, cycle.p if name == "cycle_bore_dwell" else 0.0)
+    elif name == "cycle_bore":  # G85: feed back to R, then a rapid to the clear height (zero length or not)
+        go(bottom, MOTION_LINEAR)
         go(r, MOTION_LINEAR)
-        if clear != r:
-            go(clear, MOTION_RAPID)
+        go(clear, MOTION_RAPID)
+    elif name == "cycle_bore_dwell":  # G89: feed out all the way to the clear height
+        go(bottom, MOTION_LINEAR, cycle.p)
+        go(clear, MOTION_LINEAR)
     else:  # G81, G82 and G86 feed in and rapid out
         go(bottom, MOTION_LINEAR, cycle.p if name in ("cycle_drill_dwell", "cycle_bore_stop") else 0.0)
         go(clear, MOTION_RAPID)

@@ -3,15 +3,27 @@
 A program reads INI values as ``#<_ini[SECTION]NAME>`` (sections and names
 in any case, as LinuxCNC's named parameters are), and the interpreter looks
 for subroutine files in ``[RS274NGC] SUBROUTINE_PATH`` (``:``-separated,
-relative to the INI file's folder).  As LinuxCNC's ``IniFile`` reads it:
-``[SECTION]`` lines, ``NAME = VALUE`` lines, ``#`` and ``;`` comment lines,
-and the first of repeated names wins.
+relative to the INI file's folder).  ``[RS274NGC] DISABLE_FANUC_STYLE_SUB``
+(non-zero) turns Fanuc-style subprograms off: rs274 then refuses M98 and
+M99.  As LinuxCNC's ``IniFile`` reads it: ``[SECTION]`` lines, ``NAME =
+VALUE`` lines, ``#`` and ``;`` comment lines, and the first of repeated
+names wins.
+
+Other ``[RS274NGC]`` options leave what gcodekit emulates as rs274 2.9 run
+standalone has it: ``RS274NGC_STARTUP_CODE`` is run by LinuxCNC's task,
+not by the interpreter (rs274 alone ignores it, and so does gcodekit: give
+the modes in the program, or prepend them), the ``FEATURES`` bits change
+nothing gcodekit reads (``#<_ini[...]>`` works whatever they are, as in
+rs274 2.9), and ``DISABLE_G92_PERSISTENCE`` concerns the parameter file,
+which gcodekit does not keep.
 
 Examples
 --------
 >>> ini = LinuxCncIni.parse("[VARS]\\nTOOLCHANGE_X = 10\\n[RS274NGC]\\nSUBROUTINE_PATH = subs:../lib\\n", "/m/a.ini")
 >>> ini.number("vars", "toolchange_x"), ini.number("vars", "missing"), ini.subroutine_path
 (10.0, None, ('/m/subs', '/m/../lib'))
+>>> ini.fanuc_subs, LinuxCncIni.parse("[RS274NGC]\\nDISABLE_FANUC_STYLE_SUB = 1\\n", "a.ini").fanuc_subs
+(True, False)
 """
 
 from __future__ import annotations
@@ -67,6 +79,11 @@ class LinuxCncIni:
         """The value of named parameter ``_ini[section]name`` (normalized: lower case, no spaces), or None."""
         match = _PARAMETER.fullmatch(key)
         return None if match is None else self.number(*match.groups())
+
+    @property
+    def fanuc_subs(self) -> bool:
+        """Whether Fanuc-style subprograms (M98/M99) run: ``[RS274NGC] DISABLE_FANUC_STYLE_SUB`` unset or 0."""
+        return not self.number("RS274NGC", "DISABLE_FANUC_STYLE_SUB")
 
     @property
     def subroutine_path(self) -> tuple[str, ...]:

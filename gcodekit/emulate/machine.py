@@ -358,8 +358,14 @@ class Machine:
         for ax, letter in enumerate(AXES.lower()):
             out[letter][rows] = position[:, ax]
         out["de"][rows] = de
-        # G93 gives each move a time (1/F minutes); like rs274, report the speed that makes
-        out["feed"][rows] = feed * np.where(distance > 0, distance, rotary) if s.feed_mode == "inverse_time" else feed
+        # G93 gives each move a time (1/F minutes); like rs274, report the speed that makes it, over the
+        # length from where rs274 takes the tool to be (after an offset change it may not be there yet)
+        if s.feed_mode == "inverse_time":
+            steps = np.linalg.norm((targets - np.vstack([program[None, :], targets[:-1]]))[:, :3], axis=1)
+            length = np.where(is_arc, distance, steps)
+            out["feed"][rows] = feed * np.where(length > 0, length, rotary)
+        else:
+            out["feed"][rows] = feed
         out["distance"][rows] = distance
         out["time"][rows] = time
         out["motion"][rows] = motion
@@ -368,6 +374,8 @@ class Machine:
         self.fill_state(rows, out)
 
         s.position = position[-1].copy()
+        if moving.any():
+            s.note_move()
         if s.feed_mode == "per_minute":
             s.feed = float(feed[-1])
         elif s.feed_mode == "per_rev":
@@ -423,6 +431,18 @@ class Machine:
         o1 = _take(t, l1, rows) * s.units
         o2 = _take(t, l2, rows) * s.units
         clockwise = t.motion[rows] == MOTION_CW
+        if self.rs274_blocks and "IJK"[h] in t.params:  # rs274 refuses the centre word of the plane's normal axis
+            normal = ~np.isnan(_take(t, "IJK"[h], rows))
+            for i in np.flatnonzero(normal)[:20]:
+                self.diagnostics.report(int(t.line[rows[i]]), 1, f"{'IJK'[h]} word given for arc in "
+                                        f"{arcs.PLANE_NAMES[s.plane]} plane", kind="machine")
+        if self.rs274_blocks and not np.isnan(r_word).all():
+            self._check_radius_ends(t, rows, ~np.isnan(r_word), p0, p1, "XYZ"[f] + "XYZ"[g])
+        if self.rs274_blocks and not s.arc_incremental:  # G90.1: rs274 wants both centre words
+            for letter, offsets in ((l1, o1), (l2, o2)):
+                for i in np.flatnonzero(np.isnan(r_word) & np.isnan(offsets))[:20]:
+                    self.diagnostics.report(int(t.line[rows[i]]), 1, f"{letter} word missing in absolute center arc",
+                                            kind="machine")
         no_center = np.isnan(r_word) & np.isnan(o1) & np.isnan(o2)
         for i in np.flatnonzero(no_center)[:20]:
             self.diagnostics.report(int(t.line[rows[i]]), 1, f"arc needs {l1}/{l2} offsets or R in this plane (G{s.plane})",
@@ -447,6 +467,16 @@ class Machine:
         centre = s.to_machine(centre)
         centers[idx, f] = centre[:, f]
         centers[idx, g] = centre[:, g]
+
+    def _check_radius_ends(self, t, rows, radius_form, p0, p1, letters: str) -> None:
+        """rs274 refuses an R-form arc without an end word in its plane, or ending where it starts."""
+        words = ~np.isnan(_take(t, letters[0], rows)) | ~np.isnan(_take(t, letters[1], rows))
+        first, second = sorted(letters)
+        for i in np.flatnonzero(radius_form & ~words)[:20]:
+            self.diagnostics.report(int(t.line[rows[i]]), 1, f"{first} and {second.lower()} words missing for arc "
+                                    f"in {arcs.PLANE_NAMES[self.state.plane]} plane", kind="machine")
+        for i in np.flatnonzero(radius_form & words & (np.hypot(*(p1 - p0).T) < 1e-9))[:20]:
+            self.diagnostics.report(int(t.line[rows[i]]), 1, "Current point same as end point of arc", kind="machine")
 
     def _check_radii(self, t, rows, r0, r1, units) -> None:
         # LinuxCNC 2.9 rejects centre-format arcs whose end radius differs from the start

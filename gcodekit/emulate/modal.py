@@ -24,7 +24,7 @@ from .cycles import CYCLES, TAPPING, polar_target, run_cycle
 from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
 from .splines import SPLINE_NAMES, SplineBlocks
-from .state import AXES, MachineState
+from .state import AXES, MachineState, rotate_xy
 from .tooltable import Tool
 from . import work_systems
 
@@ -128,10 +128,12 @@ class ModalHandler:
             self._cycle_name = "cycle_thread"
             motion, extra = self._threading_cycle(params, line)
         elif moves and int(t.motion[row]) == MOTION_CYCLE and name not in ("retract_initial", "retract_r"):
-            self._cycle_name = name or self._cycle_name
-            if not (int(t.motion[row - 1]) == MOTION_CYCLE if row else self.cycle_mode_open):
+            in_mode = int(t.motion[row - 1]) == MOTION_CYCLE if row else self.cycle_mode_open
+            if not in_mode:
                 s.cycle.initial = None  # the cycle mode begins here
-            motion, extra = self._cycle(name, params, line)
+            same_mode = in_mode and name in ("", self._cycle_name)  # rs274: motion_mode == motion
+            self._cycle_name = name or self._cycle_name
+            motion, extra = self._cycle(name, params, line, same_mode)
         elif moves and int(t.motion[row]) == MOTION_THREAD:
             rigid = name == "rigid_tap" or (not name and self._thread_name == "rigid_tap")
             self._thread_name = "rigid_tap" if rigid else "thread"
@@ -139,6 +141,7 @@ class ModalHandler:
                 tap = self._rigid_tap(params, line)
                 if tap is not None:  # in to the bottom, then out again at the same pitch
                     s.program_shift[:] = 0.0
+                    s.note_move()
                     self._fill_passing(tap, before)
                     bottom = np.array([tap.values[k] for k in AXES.lower()])
                     self._write(out, row, bottom, MOTION_LINEAR, feed=tap.values["feed"])
@@ -147,6 +150,7 @@ class ModalHandler:
                 rate = self._thread(params, line)
                 if rate is not None:
                     s.program_shift[:] = 0.0
+                    s.note_move()
                     self._write(out, row, before, MOTION_LINEAR, feed=rate)
                     return extra
         elif name in SPLINE_NAMES or (moves and int(t.motion[row]) in SPLINE_MOTIONS):
@@ -161,7 +165,11 @@ class ModalHandler:
             attr, value = _SIMPLE[name]
             if attr == "units" and keep_feed:
                 s.feed *= value / s.units  # the same F number in the new units
+            if attr == "units" and self.machine.rs274_blocks:
+                s.cycle.keep_numbers(value / s.units)
             setattr(s, attr, value)
+            if attr == "feed_mode" and self.machine.rs274_blocks and "F" not in params:
+                s.feed = 0.0  # rs274 2.9: G93, G94 and G95 zero the feed rate (an F in the block is set after)
             if attr == "incremental" and self.machine.config.distance_mode_sets_extrusion:
                 s.e_relative = value
         elif name.startswith("work_offset_"):
@@ -176,10 +184,13 @@ class ModalHandler:
             work_systems.restore_axis_offset(s)
         elif name in ("home", "home_secondary"):
             motion, extra = MOTION_RAPID, self._home(params, name == "home_secondary")
-        elif name == "store_home":
-            s.home = s.position.copy()
-        elif name == "store_home_secondary":
-            s.home_secondary = s.position.copy()
+        elif name in ("store_home", "store_home_secondary"):
+            # the machine point as the interpreter works it out, with the tool offset it holds
+            stored = s.position + self._tool_offset_held() - s.tool_offset
+            if name == "store_home":
+                s.home = stored
+            else:
+                s.home_secondary = stored
         elif name == "machine_coordinates":
             motion = self._machine_move(params, int(t.motion[row]), line)
         elif name == "set_flow":
@@ -214,16 +225,17 @@ class ModalHandler:
                 offset = self.machine.tools.offset(int(number))
                 # rs274 re-reads its position after a tool change, so a G43 in the
                 # M6 block keeps the program position; elsewhere the machine stays.
-                s.change_tool_offset(offset if name == "tool_length_offset" else s.tool_offset + offset,
-                                     keep_program_position=line == self._tool_change_line)
+                self._change_tool_offset(offset if name == "tool_length_offset" else self._tool_offset_held() + offset,
+                                         keep_program_position=line == self._tool_change_line)
             else:
                 self.machine.diagnostics.report(line, 1, f"H word {number:.0f} out of range (0 to {MAX_TOOL})",
                                                 kind="machine")  # rs274: a negative H is refused too
-        elif name == "tool_length_offset_dynamic":
-            scale = s.scale()
-            s.change_tool_offset([params.get(letter, 0.0) * scale[ax] for ax, letter in enumerate(AXES)])
+        elif name == "tool_length_offset_dynamic":  # G43.1: the axes it names; the others keep their offsets
+            scale, held = s.scale(), self._tool_offset_held()
+            self._change_tool_offset([params[letter] * scale[ax] if letter in params else held[ax]
+                                      for ax, letter in enumerate(AXES)])
         elif name == "cancel_tool_length":
-            s.change_tool_offset(np.zeros(6))
+            self._change_tool_offset(np.zeros(6))
         elif name == "coordinate_data":
             self._coordinate_data(params, line)
         elif name == "local_offset":
@@ -237,6 +249,7 @@ class ModalHandler:
                 return extra
         if motion != MOTION_NONE:
             s.program_shift[:] = 0.0  # the machine has reached the offsets in force
+            s.note_move()
         if self._believed is not None:
             s.keep_program_position(self._believed)
             self._believed = None
@@ -263,20 +276,19 @@ class ModalHandler:
         if "E" in params:
             s.e_program = params["E"] * s.units
 
-    def _cycle(self, name: str, params: dict, line: int) -> tuple[int, list[Waypoint]]:
+    def _cycle(self, name: str, params: dict, line: int, same_mode: bool = True) -> tuple[int, list[Waypoint]]:
         """A canned-cycle block: its moves become waypoints (see :mod:`.cycles`)."""
         s = self.state
         unit = 0.001 if self.machine.config.dwell_p_unit == "ms" else 1.0
         try:
+            if self.machine.rs274_blocks:
+                self._check_cycle_conditions(name or self._cycle_name)
             steps, end = run_cycle(name if name in CYCLES else "", params, s.cycle, program=s.program_position(),
                                    to_machine=s.to_machine, scale=s.scale(), plane=s.plane,
-                                   incremental=s.incremental, dwell_unit=unit, budget=self.machine.budget)
+                                   incremental=s.incremental, dwell_unit=unit,
+                                   same_mode=same_mode or not self.machine.rs274_blocks, budget=self.machine.budget)
         except ValueError as exc:
             self.machine.diagnostics.report(line, 1, str(exc), kind="machine")
-            return MOTION_NONE, []
-        code = _SPINDLE_CYCLES.get(name or self._cycle_name)
-        if code and s.spindle == 0 and self.machine.rs274_blocks:
-            self.machine.diagnostics.report(line, 1, f"Spindle not turning in {code}", kind="machine")
             return MOTION_NONE, []
         if not steps:
             return MOTION_NONE, []
@@ -289,6 +301,23 @@ class ModalHandler:
         self._believed = end  # where rs274 takes the tool to be (see cycles.TAPPING): kept after the block
         self._last_dwell = steps[-1].dwell
         return steps[-1].motion, extra
+
+    def _check_cycle_conditions(self, name: str) -> None:
+        """rs274 2.9's conditions on the machine for a canned cycle (raises ValueError with its message)."""
+        s = self.state
+        if s.feed <= 0:
+            raise ValueError("Cannot feed with zero feed rate")
+        if s.feed_mode == "inverse_time":
+            raise ValueError("Cannot use inverse time feed with canned cycles")
+        if s.compensating:
+            raise ValueError("Cannot use canned cycles with cutter compensation on")
+        code = _SPINDLE_CYCLES.get(name)
+        if code and s.spindle == 0:
+            raise ValueError(f"Spindle not turning in {code}")
+        if name == "cycle_tap" and s.spindle < 0:
+            raise ValueError("Spindle turning counterclockwise in G84")
+        if name == "cycle_tap_left" and s.spindle > 0:
+            raise ValueError("Spindle turning clockwise in G74")
 
     def _threading_cycle(self, params: dict, line: int) -> tuple[int, list[Waypoint]]:
         """G76: the passes of a threading cycle become waypoints (see :mod:`.threading`)."""
@@ -511,6 +540,27 @@ class ModalHandler:
         s.position = s.to_machine(program)
         s.program_shift[:] = 0.0
 
+    def _tool_offset_held(self) -> np.ndarray:
+        """The tool length offset (mm) the interpreter holds: with ``standalone_canon``, after G20/G21
+        the numbers it was set with, read in the units now in force."""
+        s = self.state
+        if self.machine.config.standalone_canon:
+            return s.tool_offset * (s.units / s.tool_offset_units)
+        return s.tool_offset
+
+    def _change_tool_offset(self, offset, keep_program_position: bool = False) -> None:
+        """A new tool length offset; the program position moves by the held offset's change (rs274's
+        ``current += old - new``, turned into the program frame), which the next move reaches when the
+        held one was stale."""
+        s = self.state
+        held = self._tool_offset_held()
+        if keep_program_position or not np.any(held != s.tool_offset):
+            s.change_tool_offset(offset, keep_program_position)
+            return
+        believed = s.program_position() + rotate_xy(held - np.asarray(offset, float), -s.rotation)
+        s.change_tool_offset(offset)
+        s.keep_program_position(believed)
+
     def _coordinate_data(self, params: dict, line: int) -> None:
         """G10: L2/L20 set a work offset, L1/L10/L11 a tool's offsets (LinuxCNC 2.9)."""
         s = self.state
@@ -549,7 +599,8 @@ class ModalHandler:
 
     def _home(self, params: dict, secondary: bool) -> list[Waypoint]:
         s = self.state
-        stored = s.home_secondary if secondary else s.home
+        # (a stale tool offset the interpreter holds shifts the machine point it aims at, see standalone_canon)
+        stored = (s.home_secondary if secondary else s.home) + s.tool_offset - self._tool_offset_held()
         given = [ax for ax, letter in enumerate(AXES) if letter in params]
         if self.machine.config.home_mode == "select":
             for ax in given or [0, 1, 2]:
@@ -572,10 +623,18 @@ class ModalHandler:
             return MOTION_NONE
         if s.incremental:
             self.machine.diagnostics.report(line, 1, "G53 is not allowed in incremental mode (G91)", kind="machine")
-        scale = s.scale()
+        # rs274 (find_ends) works the target out in program coordinates from its own idea of the
+        # current point: an axis without a word keeps that point's coordinate in the turned frame
+        scale, held, program = s.scale(), self._tool_offset_held(), s.program_position()
+        target = program.copy()
+        turned = rotate_xy(program + s.g92, s.rotation)
         for ax, letter in enumerate(AXES):
-            if letter in params:
-                s.position[ax] = params[letter] * scale[ax]
+            if ax < 2:
+                turned[ax] = params[letter] * scale[ax] - s.frame[ax] - held[ax] if letter in params else turned[ax]
+            elif letter in params:
+                target[ax] = params[letter] * scale[ax] - s.frame[ax] - s.g92[ax] - (held[ax] if ax == 2 else 0.0)
+        target[:2] = rotate_xy(turned, -s.rotation)[:2] - s.g92[:2]
+        s.position = s.to_machine(target)
         return motion
 
     def _tool(self, t: CommandTable, row: int, params: dict) -> None:
@@ -595,6 +654,10 @@ class ModalHandler:
                 self._check_tool(int(params["T"]), int(t.line[row]))
             s.selected_tool = int(params.get("T", s.selected_tool))
             s.tool = s.selected_tool
+            if self.machine.rs274_blocks and NAMES[int(t.name[row])] == "tool_change":
+                s.spindle = 0  # rs274 stops the spindle for the change (a G86 after M6 is refused)
+                if self.machine.config.standalone_canon:  # it re-reads its position (see standalone_canon)
+                    s.keep_program_position(s.canon_point - s.frame - s.g92)
 
     def _check_tool(self, number: int, line: int) -> None:
         """With a tool table, selecting a tool it lacks is LinuxCNC's error (T0, no tool, is fine);

@@ -80,6 +80,19 @@ class MachineConfig:
         feed, interp_convert.cc ``convert_length_units``; the LinuxCNC golden
         tests turn it on); LinuxCNC's task, which converts the rate it holds,
         and printer firmware keep the speed (false, the default).
+    standalone_canon : bool
+        Hand the interpreter back what rs274 run standalone hands back when
+        it re-reads its state (its canon, saicanon.cc, keeps numbers as it
+        was given them; LinuxCNC's task converts them and knows where the
+        machine is).  G20/G21 keep the tool length offset's numbers, so an
+        offset set in mm is taken as that many inches when the offset next
+        changes (G43, G43.1, G43.2, G49: the program position jumps by the
+        difference) and when G28, G30 and G53 aim at machine coordinates.
+        After M6 the program position is re-read as the last move's program
+        point, moved by later work and G92 offset changes but not by tool
+        length offsets or XY rotations.  The next move goes there.  The
+        LinuxCNC golden tests and the differential check turn it on (false,
+        the default).
     distance_mode_sets_extrusion : bool
         G90/G91 also switch E to absolute/relative, overriding M82/M83
         (Marlin, RepRapFirmware).  Everywhere, E is relative under G91.
@@ -150,6 +163,7 @@ class MachineConfig:
     empty_moves: bool = False
     probe_backoff: float = 0.0
     units_keep_feed: bool = False
+    standalone_canon: bool = False
     distance_mode_sets_extrusion: bool = False
     block_delete: bool = False
     filament_diameter: float = 1.75

@@ -69,6 +69,10 @@ class MachineState:
     g92_stored: np.ndarray = field(default_factory=_zeros)  # as stored (#5211-#5219): G92.3 brings it back
     g92_on: bool = False  # #5210: set by G92, G52 and G92.3, cleared by G92.1 and G92.2
     tool_offset: np.ndarray = field(default_factory=_zeros)  # G43 tool length offset
+    tool_offset_units: float = 1.0  # mm per program unit when the offset was set (see standalone_canon)
+    # program point of the last move plus the work and G92 offsets then in force: what rs274 run
+    # standalone re-reads as its position after M6, less the offsets in force (see standalone_canon)
+    canon_point: np.ndarray = field(default_factory=_zeros)
     # rs274 keeps the program position when the tool offset changes in an M6
     # block, and turns it with a work system's new rotation: the machine reaches
     # the new frame on the next move.  Until then the program position differs
@@ -108,6 +112,10 @@ class MachineState:
     def program_position(self) -> np.ndarray:
         return self.to_program(self.position) + self.program_shift
 
+    def note_move(self) -> None:
+        """The machine has moved: remember the end for rs274 standalone's position after M6."""
+        self.canon_point = self.program_position() + self.frame + self.g92
+
     def keep_program_position(self, program: np.ndarray) -> None:
         """After an offset change: the program position is ``program`` until the next move.
 
@@ -126,6 +134,7 @@ class MachineState:
         """
         before = self.program_position()
         self.tool_offset = np.asarray(offset, float).copy()
+        self.tool_offset_units = self.units
         if keep_program_position:
             self.keep_program_position(before)
 

@@ -86,7 +86,6 @@ _FILE_NAME = re.compile(r"[a-z0-9_-]+")
 # A called name that reaches for a path: refused, so a program cannot read files elsewhere.
 _PATH_PARTS = re.compile(r"[/\\]|\.\.")
 _CONDITIONS = ("if", "elseif", "while", "repeat")
-_LOOPS = ("while", "do", "repeat")
 _CLOSERS = {"endsub": "sub", "endif": "if", "endwhile": "while", "endrepeat": "repeat"}
 
 
@@ -174,6 +173,9 @@ class ControlFlowStage:
     search_path : sequence of path, default: ()
         Directories searched, after the program's own, for ``name.ngc``
         when ``o<name> call`` names a subroutine the program lacks.
+    fanuc_subs : bool, default: True
+        Fanuc-style subprograms run (M98/M99); False refuses them, as
+        rs274 does under ``[RS274NGC] DISABLE_FANUC_STYLE_SUB``.
     max_iterations, max_call_depth, max_lines, max_motions : int
         Limits; default :data:`~gcodekit.limits.MAX_ITERATIONS`,
         :data:`MAX_CALL_DEPTH`, :data:`MAX_LINES`,
@@ -194,12 +196,14 @@ class ControlFlowStage:
     name = "control_flow"
 
     def __init__(self, flavor: Flavor, store: ParameterStore | None = None, *,
-                 search_path: Sequence[str | os.PathLike] = (), max_iterations: int = MAX_ITERATIONS,
-                 max_call_depth: int = MAX_CALL_DEPTH, max_lines: int = MAX_LINES, max_motions: int = MAX_MOTIONS):
+                 search_path: Sequence[str | os.PathLike] = (), fanuc_subs: bool = True,
+                 max_iterations: int = MAX_ITERATIONS, max_call_depth: int = MAX_CALL_DEPTH,
+                 max_lines: int = MAX_LINES, max_motions: int = MAX_MOTIONS):
         self.flavor = flavor
         self.parameters = ParameterStage(flavor, store)
         self.store = self.parameters.store
         self.search_path = [Path(p) for p in search_path]
+        self.fanuc_subs = fanuc_subs
         self.max_iterations = max_iterations
         self.max_call_depth = max_call_depth
         self.max_lines = max_lines
@@ -232,6 +236,9 @@ class _Run:
         self.code = _Code("", [])
         self.pc = 0
         self.counters: dict[int, int] = {}
+        # rs274 2.9: after a ``break`` out of a ``while`` loop, the next ``while`` that closes a
+        # ``do`` does not loop back (the do's body runs once), wherever that do is
+        self.broke_while = False
 
     # -- running -------------------------------------------------------------
 
@@ -303,7 +310,10 @@ class _Run:
             # Reached from the branch before it, which ran: leave the if.
             self.pc = st.end + 1 if st.end >= 0 else self.pc + 1
         elif k == "while" and st.start >= 0:  # closes a do
-            if self._condition(st):
+            if self.broke_while:
+                self.broke_while = False
+                self.pc += 1
+            elif self._condition(st):
                 self._tick(st)
                 self.pc = st.start + 1
             else:
@@ -358,6 +368,7 @@ class _Run:
         if st.keyword == "break":
             self.counters.pop(st.start, None)
             self.pc = loop.end + 1
+            self.broke_while |= loop.keyword == "while"
         elif loop.keyword == "while":
             self._tick(st)
             self.pc = st.start
@@ -531,6 +542,9 @@ class _Run:
             yield line
             if not text.lstrip().startswith("/"):  # a block-deleted end may be skipped
                 raise _Stop
+            return
+        if not self.stage.fanuc_subs:
+            self._report(line, 1, f"DISABLE_FANUC_STYLE_SUB set in INI file, but found m{code}")
             return
         rest = _remove(text, spans)
         if rest.strip(" \t" + self.separators):
@@ -802,8 +816,8 @@ class _Run:
                     st.valid = False
                 else:
                     chain.append(i)
-            elif k in ("break", "continue"):
-                j = self._open(items, stack, st, _LOOPS)
+            elif k in ("break", "continue"):  # rs274 2.9 refuses them in a repeat loop, run or not
+                j = self._open(items, stack, st, ("while", "do"))
                 if j is not None:
                     st.start = j
             elif k == "return":

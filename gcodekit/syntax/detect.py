@@ -21,14 +21,22 @@ HEAD_CHARS = 64 * 1024
 HEAD_LINES = 4000
 
 #: Points per piece of evidence.  A header match (slicer banner, dialect-only
-#: command) outweighs any number of shared codes a short head can hold.
+#: command) outweighs any number of shared codes a short head can hold; the
+#: dialect's own file extension (``.ngc``) outweighs one header, one unrelated
+#: dialects share (``.nc``, ``.tap``) is only a hint; what the dialect cannot
+#: read (``against``) outweighs a header and what else a short head holds.
 HEADER_POINTS = 10.0
-EXTENSION_POINTS = 3.0
+AGAINST_POINTS = 20.0
+EXTENSION_POINTS = 12.0
+SHARED_EXTENSION_POINTS = 1.0
+HINT_POINTS = 3.0
 E_WORD_POINTS = 2.0
 CODE_POINTS = 1.0
 COMMENT_POINTS = 1.0
 #: Below this best score the evidence is too thin and a default is used.
 MIN_SCORE = 3.0
+#: Below this best score (less than a header or a unique extension) the choice is weak.
+STRONG_SCORE = 10.0
 #: Candidates within this many points of the winner are reported as close.
 CLOSE_POINTS = 1.0
 
@@ -53,12 +61,16 @@ class Detection:
         The evidence for the choice, in words.
     candidates : tuple of (str, float)
         Every flavor that scored, best first.
+    weak : bool
+        The evidence is thin: a default was used, the winner scored less
+        than a header's worth, or a flavor on other evidence came close.
     """
 
     name: str
     score: float
     reasons: tuple[str, ...]
     candidates: tuple[tuple[str, float], ...]
+    weak: bool = False
 
 
 @dataclass(frozen=True)
@@ -66,8 +78,11 @@ class _Rules:
     name: str
     priority: int
     header: tuple[re.Pattern[str], ...]
+    hints: tuple[re.Pattern[str], ...]
+    against: tuple[re.Pattern[str], ...]
     codes: frozenset[str]
     extensions: tuple[str, ...]
+    shared_extensions: tuple[str, ...]
     comment: str
     extrudes: bool
 
@@ -83,8 +98,11 @@ def _all_rules() -> tuple[_Rules, ...]:
                 name,
                 d.priority,
                 tuple(re.compile(p) for p in d.header),
+                tuple(re.compile(p) for p in d.hints),
+                tuple(re.compile(p) for p in d.against),
                 frozenset(d.codes),
                 d.extensions,
+                d.shared_extensions,
                 d.comment,
                 "e" in flavor.words.values(),
             )
@@ -110,14 +128,19 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     """Guess the flavor of a program from its head and file name.
 
     Points per flavor: 10 for each ``[detect] header`` regex found (slicer
-    banners such as ``;FLAVOR:Marlin``, dialect-only commands such as
-    Klipper's ``PRINT_START``), 3 for a typical file extension, 2 for E words
-    on moves if the flavor extrudes, 1 for each typical code present and 1
-    for the usual comment style.  The best score wins; equal scores go to
-    the higher ``priority``.  Below 3 points the evidence is too thin and a
-    default is used: ``"marlin"`` for programs with E words on moves and
-    without parenthesised comments, ``"rs274ngc"`` (the reference language)
-    otherwise.
+    banners such as ``;FLAVOR:Marlin``, dialect-only syntax such as
+    LinuxCNC's ``o<name> sub`` and ``#<name>`` or Klipper's
+    ``PRINT_START``), 20 taken away for each ``against`` regex found (text
+    the dialect cannot read so: words after ``;`` in Fanuc), 12 for one of
+    the flavor's file extensions (``.ngc``) and 1 for one it shares with
+    other dialects (``.nc``, ``.tap``), 3 for each ``hints`` regex found in the code,
+    2 for E words on moves if the flavor extrudes, 1 for each typical code
+    present and 1 for the usual comment style.  The best score wins; equal
+    scores go to the higher ``priority``.  Below 3 points the evidence is
+    too thin and a default is used: ``"marlin"`` for programs with E words
+    on moves and without parenthesised comments, ``"rs274ngc"`` (the
+    reference language) otherwise.  The choice is ``weak`` below 10 points
+    or with a candidate on other headers within a point of the winner.
 
     Parameters
     ----------
@@ -146,10 +169,11 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     """
     lines = text_head[:HEAD_CHARS].splitlines()[:HEAD_LINES]
     head = "\n".join(lines)
+    bare = _COMMENTS.sub("", head)
     suffix = os.path.splitext(os.fspath(filename))[1].lower() if filename is not None else ""
     present = _codes_in(head)
     style = _comment_style(lines)
-    e_words = _E_WORD.search(_COMMENTS.sub("", head)) is not None
+    e_words = _E_WORD.search(bare) is not None
 
     scored: list[tuple[float, int, str, list[str]]] = []
     for rules in _all_rules():
@@ -158,9 +182,20 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
             if pattern.search(head):
                 score += HEADER_POINTS
                 reasons.append(f"header matches /{pattern.pattern}/")
+        for pattern in rules.against:
+            if pattern.search(head):
+                score -= AGAINST_POINTS
+                reasons.append(f"against: text matches /{pattern.pattern}/")
+        for pattern in rules.hints:
+            if pattern.search(bare):
+                score += HINT_POINTS
+                reasons.append(f"code matches /{pattern.pattern}/")
         if suffix and suffix in rules.extensions:
             score += EXTENSION_POINTS
             reasons.append(f"file extension {suffix}")
+        elif suffix and suffix in rules.shared_extensions:
+            score += SHARED_EXTENSION_POINTS
+            reasons.append(f"file extension {suffix} (other dialects use it too)")
         if e_words and rules.extrudes:
             score += E_WORD_POINTS
             reasons.append("E words on moves")
@@ -184,13 +219,17 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
             0.0,
             (f"no flavor scored {MIN_SCORE:g} points; default {default!r} ({why})",),
             candidates,
+            weak=True,
         )
     close = [(n, s) for n, s in candidates[1:] if s >= best_score - CLOSE_POINTS]
     if close:
         listed = ", ".join(f"{n} ({s:g})" for n, s in close)
         by = "priority" if close[0][1] == best_score else "score"
         reasons = [*reasons, f"close candidates: {listed}; chose {best!r} by {by}"]
-    return Detection(best, best_score, tuple(reasons), candidates)
+    # a close candidate on the same headers is a relative (Klipper's banners are Marlin's): no doubt there
+    headers = {name: {r for r in why if r.startswith("header")} for _, _, name, why in scored}
+    rival = any(headers[name] != headers[best] for name, _ in close)
+    return Detection(best, best_score, tuple(reasons), candidates, weak=rival or best_score < STRONG_SCORE)
 
 
 def guess_flavor(text_head: str, filename: str | os.PathLike[str] | None = None) -> Flavor:

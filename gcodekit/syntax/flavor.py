@@ -76,10 +76,22 @@ class DetectRules:
     header : tuple of str
         Regular expressions searched in the first lines (slicer banners,
         ``;FLAVOR:`` lines); a match is strong evidence.
+    hints : tuple of str
+        Regular expressions searched in the code (comments left out) that
+        suggest the dialect without proving it (LinuxCNC's bracketed
+        expressions, which Fanuc macros share).
+    against : tuple of str
+        Regular expressions searched in the first lines that the dialect
+        cannot read as written (text after ``;``, Fanuc's end of block):
+        a match is strong evidence against it.
     codes : tuple of str
         Codes typical of the dialect (``M82``, ``SET_VELOCITY_LIMIT``).
     extensions : tuple of str
-        File suffixes typical of the dialect (``.ngc``, ``.nc``).
+        File suffixes of the dialect (``.ngc``, and its relatives': Marlin's
+        ``.gcode`` for Klipper): strong evidence.
+    shared_extensions : tuple of str
+        File suffixes it shares with unrelated dialects (``.nc``, ``.tap``):
+        a hint only.
     comment : str
         The comment style the dialect mostly uses: ``";"``, ``"("`` or ``""``.
     priority : int
@@ -87,8 +99,11 @@ class DetectRules:
     """
 
     header: tuple[str, ...] = ()
+    hints: tuple[str, ...] = ()
+    against: tuple[str, ...] = ()
     codes: tuple[str, ...] = ()
     extensions: tuple[str, ...] = ()
+    shared_extensions: tuple[str, ...] = ()
     comment: str = ""
     priority: int = 0
 

@@ -280,11 +280,13 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
         _check_regex(pattern, f"{path}: layer_comments")
     if get("feature_comment"):
         _check_regex(get("feature_comment"), f"{path}: feature_comment", group=True)
-    for pattern in detect.get("header", ()):
-        _check_regex(pattern, f"{path}: [detect] header")
-    for ext in detect.get("extensions", ()):
-        if not re.fullmatch(r"\.[A-Za-z0-9_.]+", ext):
-            raise ConfigError(f"{path}: [detect] extensions: {ext!r} is not a suffix such as '.ngc'")
+    for key in ("header", "hints", "against"):
+        for pattern in detect.get(key, ()):
+            _check_regex(pattern, f"{path}: [detect] {key}")
+    for key in ("extensions", "shared_extensions"):
+        for ext in detect.get(key, ()):
+            if not re.fullmatch(r"\.[A-Za-z0-9_.]+", ext):
+                raise ConfigError(f"{path}: [detect] {key}: {ext!r} is not a suffix such as '.ngc'")
 
     values: dict[str, Any] = {}
     for key, kind in _FLAVOR_KEYS.items():
@@ -293,7 +295,8 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
         elif key in data and kind != "table" and key not in _EXTRA_KEYS:
             values[key] = data[key]
     rules = {k: tuple(v) if isinstance(v, list) else v for k, v in detect.items()}
-    rules["extensions"] = tuple(e.lower() for e in rules.get("extensions", ()))
+    for key in ("extensions", "shared_extensions"):
+        rules[key] = tuple(e.lower() for e in rules.get(key, ()))
     return Flavor(
         **values,
         words=MappingProxyType(words),

@@ -13,9 +13,13 @@ per program:
 * ``DIFF``, ``ERR-MISS``, ``ERR?`` (rs274's error line not found in the
   file), ``HARNESS`` (timeout or crash), with what differs.
 
+With ``--detect`` gcodekit reads each program as a user would, with the
+flavor it detects (no ``flavor``/``machine`` given; the rs274-standalone
+options still apply), and each line also names that flavor.
+
 Usage::
 
-    .venv/bin/python tests/golden/linuxcnc/check_suite.py DIR [--skip PREFIX ...]
+    .venv/bin/python tests/golden/linuxcnc/check_suite.py DIR [--detect] [--skip PREFIX ...]
 
 Each program runs in its own process under a time and memory limit.  Needs
 ``/usr/bin/rs274`` and LinuxCNC's ``gcode`` module (see README.md).
@@ -51,14 +55,14 @@ def options(program: Path) -> list[Path | None]:
     return found
 
 
-def check(program: Path, workdir: Path) -> tuple[str, str]:
-    """(verdict, detail) for one program."""
+def check(program: Path, workdir: Path, detect: bool = False) -> tuple[str, str]:
+    """(verdict, detail) for one program; with ``detect``, gcodekit detects the flavor."""
     sys.path.insert(0, str(HERE.parents[2]))
     sys.path.insert(0, str(HERE.parents[1]))
     sys.path.insert(0, str(HERE))
     import gcodekit
     from errors import expected_line
-    from test_linuxcnc_golden import AXES, CENTRE, first_difference, ours_like_canon, reference_motions
+    from test_linuxcnc_golden import AXES, CENTRE, RS274_STANDALONE, first_difference, ours_like_canon, reference_motions
 
     ini, table, var = options(program)
     command = ["bash", str(SHARED_TOOLS / "run_rs274.sh"), *(["-i", str(ini)] if ini else []),
@@ -69,8 +73,11 @@ def check(program: Path, workdir: Path) -> tuple[str, str]:
     csv = workdir / "out.canon.csv"
     subprocess.run(["/usr/bin/python3", str(SHARED_TOOLS / "canon_to_csv.py"), str(canon), "-o", str(csv),
                     "--src", str(program)], capture_output=True, text=True)
-    op = gcodekit.gcode_to_operation(program, machine="linuxcnc", plan=False, tool_table=str(table or DEFAULT_TABLE),
-                                     tool_table_units="inch", units_keep_feed=True, ini_file=str(ini or ""))
+    emulation = {k: v for k, v in RS274_STANDALONE.items() if not (detect and k == "machine")}
+    op = gcodekit.gcode_to_operation(program, plan=False, tool_table=str(table or DEFAULT_TABLE),
+                                     ini_file=str(ini or ""), **emulation)
+    if detect:
+        workdir.joinpath("flavor").write_text(op.flavor.name)
     errors = [d for d in op.diagnostics.items if d.severity == "error"]
     shown = [str(d) for d in errors[:2]]
     if rs274.returncode != 0:
@@ -93,20 +100,23 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("suite", type=Path)
     ap.add_argument("--skip", nargs="*", default=[], help="programs (paths under the suite) to leave out")
+    ap.add_argument("--detect", action="store_true", help="let gcodekit detect each program's flavor")
     ap.add_argument("--one", help=argparse.SUPPRESS)  # the child process's program
     args = ap.parse_args(argv)
     if args.one:
         with tempfile.TemporaryDirectory() as workdir:
-            verdict, detail = check(args.suite / args.one, Path(workdir))
+            verdict, detail = check(args.suite / args.one, Path(workdir), args.detect)
+            flavor = Path(workdir, "flavor")
+            detail = f"[{flavor.read_text()}] {detail}" if flavor.exists() else detail
         print(f"{args.one}\t{verdict}\t{detail}")
         return 0
     verdicts: Counter[str] = Counter()
     for program in sorted(args.suite.rglob("*.ngc")):
         name = str(program.relative_to(args.suite))
-        if "subs/" in name or name.startswith(tuple(args.skip)):
+        if "subs" in Path(name).parts[:-1] or name.startswith(tuple(args.skip)):
             continue  # subroutine files, and programs rs274 loops on
         child = subprocess.run(f"ulimit -v 4000000; exec timeout 300 {sys.executable} {__file__} {args.suite} "
-                               f"--one {name!r}", shell=True, capture_output=True, text=True)
+                               f"--one {name!r}" + " --detect" * args.detect, shell=True, capture_output=True, text=True)
         line = next((out for out in child.stdout.splitlines() if out.startswith(name + "\t")),
                     f"{name}\tHARNESS\texit {child.returncode}: {child.stderr[-200:]!r}")
         print(line, flush=True)

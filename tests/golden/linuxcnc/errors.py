@@ -21,9 +21,13 @@ skipped with the reason (see :data:`SKIP` and :data:`KNOWN_GAPS`); ``errors/mani
 every error program and ``errors/expected.tsv`` the kept ones:
 ``program  line  message  block``.
 
+``own_errors/`` holds programs we wrote for rules the corpus lacks, each with
+rs274's ``.canon.err`` beside it; they are copied in as ``own__NAME.ngc``
+(``--rerun`` runs rs274 on them afresh first).
+
 Usage::
 
-    python tests/golden/linuxcnc/errors.py [--corpus DIR]
+    python tests/golden/linuxcnc/errors.py [--corpus DIR] [--rerun]
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 OUT = HERE / "errors"
+OWN = HERE / "own_errors"
 SHARED = HERE.parents[3] / "shared"
 REFERENCE = "LinuxCNC 2.9.0~pre1 rs274 (Debian 12 linuxcnc-uspace)"
 FILE_ENDED = "File ended with no percent sign"
@@ -93,10 +98,20 @@ def case_name(program: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--corpus", type=Path, default=SHARED / "corpus" / "linuxcnc")
+    ap.add_argument("--rerun", action="store_true", help="run rs274 on the programs of own_errors/ afresh")
     args = ap.parse_args(argv)
     corpus: Path = args.corpus
     with (corpus / "RESULTS.tsv").open(newline="") as f:
         results = [r for r in csv.DictReader(f, delimiter="\t") if r["status"] == "error"]
+    own = sorted(OWN.glob("*.ngc"))
+    if args.rerun:
+        from differential.rs274 import run_rs274
+
+        for program in own:
+            refused = run_rs274(program.read_text()).error
+            if refused is None:
+                ap.error(f"rs274 runs {program} without an error")
+            program.with_name(program.name + ".canon.err").write_text("\n".join(refused) + "\n")
     OUT.mkdir(exist_ok=True)
     for old in OUT.iterdir():
         old.unlink()
@@ -119,6 +134,14 @@ def main(argv: list[str] | None = None) -> int:
         shutil.copyfile(err, OUT / (name + ".canon.err"))
         manifest.append([row["file"], line, "yes", how, message])
         expected.append([name, line, message, block.strip()])
+    for program in own:
+        message, _, block = program.with_name(program.name + ".canon.err").read_text().partition("\n")
+        line, how = expected_line(program, message, block.rstrip("\n"))
+        name = "own__" + program.name
+        shutil.copyfile(program, OUT / name)
+        shutil.copyfile(program.with_name(program.name + ".canon.err"), OUT / (name + ".canon.err"))
+        manifest.append([f"own_errors/{program.name}", line, "yes", how, message])
+        expected.append([name, line, message, block.strip()])
     with (OUT / "manifest.tsv").open("w", newline="") as f:
         w = csv.writer(f, delimiter="\t", lineterminator="\n")
         w.writerow(["program", "line", "kept", "how or why not", "rs274 message"])
@@ -127,7 +150,8 @@ def main(argv: list[str] | None = None) -> int:
         w = csv.writer(f, delimiter="\t", lineterminator="\n")
         w.writerow(["case", "line", "message", "block"])
         w.writerows(expected)
-    print(f"{len(expected)} of {len(results)} error programs kept ({REFERENCE})")
+    print(f"{len(expected) - len(own)} of {len(results)} corpus error programs kept and {len(own)} of our own "
+          f"({REFERENCE})")
     return 0
 
 
