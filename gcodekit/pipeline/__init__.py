@@ -1,0 +1,192 @@
+"""Pipeline: compose the stages, from a program's text to a planned Operation.
+
+No stage calls another sideways; the pipeline chooses the flavor and the
+machine (:mod:`.program`), streams the program through the read, parse and
+emulate stages chunk by chunk (:mod:`.source`), joins the chunks into one
+:class:`~gcodekit.model.operation.Operation` (:mod:`.assemble`), runs the
+compensation pass and the planner, and returns it.  The one loop against
+that flow, the machine's state read back by the parameter stage, is
+:mod:`.feedback`.
+
+Examples
+--------
+>>> import gcodekit
+>>> df = gcodekit.gcode_file_to_dataframe("G1 X10 Y0 F600\\nG2 X0 Y0 I-5 J0\\n", machine="linuxcnc", plan=False)
+>>> df[["motion", "x", "distance"]].round(3).values.tolist()
+[['feed', 10.0, 10.0], ['arc_cw', 0.0, 15.708]]
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from typing import TYPE_CHECKING
+
+from ..emulate.compensation import compensate, uses_compensation
+from ..emulate.presets import MachineConfig, load_machine
+from ..errors import ConfigError, Diagnostics, GcodeError, check_choice
+from ..limits import MAX_ITERATIONS, MAX_MOTIONS, Limits
+from ..memory import release_freed_memory
+from ..model.operation import OPERATION_CLASSES, Operation
+from ..parse import CommandTable, GcodeParser
+from ..plan import machine_options as firmware_options
+from ..plan import planner_settings, run_planner
+from ..read import Blocks
+from ..syntax import Flavor
+from .assemble import concat_waypoints, empty_table, new_machine, raise_first_run
+from .program import Program, as_program, check_program_end, note_weak_detection, progress_bar, quote_diagnostics, resolve
+from .source import program_blocks, restore_line_numbers
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate_operation", "resolve",
+           "as_program", "Program"]
+
+
+def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None, *,
+                  mode: str = "lenient") -> Operation:
+    """Read and parse a program without emulating it (no process data yet)."""
+    program = as_program(source)
+    fl, config, detection = resolve(program, None, flavor)
+    diagnostics = Diagnostics(program.name, mode)
+    note_weak_detection(detection, diagnostics)
+    parser = GcodeParser(fl, diagnostics)
+    parts, n_lines = [], 0
+    for blocks, lines in program_blocks(program, fl, diagnostics):
+        parts.append(parser.parse(blocks))
+        n_lines += lines
+    cls = OPERATION_CLASSES[config.process]
+    table = CommandTable.concat(parts) if parts else empty_table(parser, program)
+    restore_line_numbers(table, diagnostics)
+    return cls(table, file=program.name, flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
+
+
+def emulate_operation(operation: Operation, machine: str | MachineConfig | None = None) -> Operation:
+    """Run a parsed operation on a machine; returns the same operation, emulated."""
+    config = operation.machine if machine is None else (
+        machine if isinstance(machine, MachineConfig) else load_machine(machine))
+    operation.waypoints = new_machine(operation.flavor, config, operation.diagnostics).run(operation.table)
+    operation.machine = config
+    return operation
+
+
+def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig | None = None, *,
+                       flavor: str | Flavor | None = None, mode: str = "lenient",
+                       progress: bool = False, machine_config: str | os.PathLike | None = None,
+                       plan: bool = True, max_motions: int = MAX_MOTIONS, max_iterations: int = MAX_ITERATIONS,
+                       **machine_options) -> Operation:
+    """Read, parse and emulate a program into an :class:`Operation`.
+
+    Parameters
+    ----------
+    source : path or str
+        A program file (plain or compressed) or the program text itself.
+    machine : str or MachineConfig, default: the preset for the flavor
+        ``"linuxcnc"``, ``"marlin"``, ``"klipper"``, ``"grbl"``, ... (see
+        :func:`gcodekit.list_machines`).
+    flavor : str or Flavor, default: the machine's, else detected
+    mode : {"lenient", "strict"}, default: "lenient"
+        Lenient records problems in ``operation.diagnostics`` and goes on;
+        strict raises the first as a :class:`~gcodekit.errors.GcodeError`.
+    progress : bool, default: False
+        Show a progress bar on standard error.
+    machine_config : path, optional
+        The firmware's own configuration (Klipper ``printer.cfg``) for the
+        machine's planner; its values replace the preset's.
+    plan : bool, default: True
+        Time the moves with the machine's motion planner, if it has one.
+    max_motions, max_iterations : int, default: 50 million, 100 000
+        Limits on the motions the program may make and the loop iterations
+        it may run; a program that passes one stops there with an error
+        naming the line (see :mod:`gcodekit.limits`).
+    **machine_options
+        Override preset values (``rapid_feed=5000``).
+
+    Returns
+    -------
+    Operation, AdditiveOperation or SubtractiveOperation (by the machine's process).
+
+    Examples
+    --------
+    >>> op = gcode_to_operation("G21\\nG0 X10\\nG1 Y5 F300\\n", machine="linuxcnc", plan=False)
+    >>> op.process_data[2].location[:2], op.process_data[2].duration
+    ((10.0, 5.0), 1.0)
+    """
+    check_choice("mode", mode, ("lenient", "strict"))
+    limits = Limits(max_motions, max_iterations)
+    program = as_program(source)
+    fl, config, detection = resolve(program, machine, flavor, **machine_options)
+    if machine_config is not None:
+        if not config.planner:
+            raise ConfigError(f"machine {config.name!r} has no planner to read {os.fspath(machine_config)!r}")
+        config = dataclasses.replace(config, **firmware_options(config.planner, machine_config))
+    diagnostics = Diagnostics(program.name, mode)
+    note_weak_detection(detection, diagnostics)
+    op, reading_error, machine_run = _emulated(program, fl, config, diagnostics, limits, progress)
+    if uses_compensation(op):
+        compensate(op, machine_run.tools, machine_run.comp_profile_ends)
+    if mode == "strict":
+        raise_first_run(op, program, reading_error)
+        diagnostics.extend(op.diagnostics)  # its warnings
+        op.diagnostics = diagnostics
+    if plan and config.planner:
+        run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
+    restore_line_numbers(op.table, diagnostics)
+    quote_diagnostics(op.diagnostics, program)
+    return op
+
+
+def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits,
+              progress: bool):
+    """Read, parse and emulate the program chunk by chunk into one Operation.
+
+    Returns the operation, the reading error strict mode holds back (the
+    error of a line that ran earlier wins, see :func:`.assemble.raise_first_run`)
+    and the machine, whose tool table and lathe profiles the compensation
+    pass needs.  In strict mode the machine reports to a lenient collector,
+    so that every line runs before the first error is chosen.
+    """
+    parser = GcodeParser(fl, diagnostics)
+    machine_diagnostics = Diagnostics(program.name, "lenient") if diagnostics.mode == "strict" else diagnostics
+    machine_diagnostics.elsewhere = diagnostics.elsewhere
+    m = new_machine(fl, config, machine_diagnostics, limits)
+    tables, waypoints, n_lines = [], [], 0
+    bar = progress_bar(program, progress)
+
+    def emulate(blocks: Blocks, lines: int) -> None:
+        nonlocal n_lines
+        table = parser.parse(blocks)
+        tables.append(table)
+        waypoints.append(m.run(table))
+        n_lines += lines
+
+    reading_error = None
+    try:
+        for blocks, lines in program_blocks(program, fl, diagnostics, bar, machine=(m, emulate), limits=limits,
+                                            search_path=config.subroutine_path + (m.ini.subroutine_path if m.ini else ()),
+                                            fanuc_subs=m.ini.fanuc_subs if m.ini else True):
+            emulate(blocks, lines)
+    except GcodeError as exc:  # strict mode: raised later unless a line run before it failed
+        reading_error = exc
+    if bar is not None:
+        bar.close()
+    sizes = [len(t) for t in tables]
+    table = CommandTable.concat(tables) if tables else empty_table(parser, program)
+    if not tables:
+        waypoints, sizes = [m.run(table)], [0]
+    if fl.percent_delimiter and program.path is not None and not program.preprocessed and reading_error is None:
+        check_program_end(program, table, n_lines, machine_diagnostics)  # rs274 finds it after the last line ran
+    op = OPERATION_CLASSES[config.process](
+        table, concat_waypoints(waypoints, sizes), file=program.name, flavor=fl, machine=config,
+        diagnostics=machine_diagnostics, n_lines=n_lines, max_motions=limits.max_motions)
+    tables.clear()
+    waypoints.clear()
+    release_freed_memory()  # the reader's per-chunk garbage, before the planner's arrays
+    return op, reading_error, m
+
+
+def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineConfig | None = None,
+                            **kwargs) -> "pd.DataFrame":
+    """The waypoint table of a program as a DataFrame (see ``Operation.to_dataframe``)."""
+    return gcode_to_operation(source, machine, **kwargs).to_dataframe()

@@ -1,0 +1,150 @@
+"""Pipeline: where a program comes from, which flavor and machine read it, and quoting its lines.
+
+A program is a file (plain or compressed) or text given directly;
+:func:`resolve` picks the flavor and machine the caller named, or detects
+them.  The file-level checks that need the whole file (how it ends) and the
+quoting of diagnostics' source lines live here too, since they read the
+program again by its path.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import sys
+from pathlib import Path
+from typing import Iterator
+
+from ..emulate.presets import MachineConfig, default_machine_for, load_machine, with_options
+from ..errors import Diagnostics
+from ..parse import CommandTable
+from ..parse.table import NAME_ID
+from ..read import iter_lines
+from ..syntax import Detection, Flavor, detect_flavor, load_flavor
+
+__all__ = ["Program", "as_program", "resolve", "note_weak_detection", "check_program_end", "quote_diagnostics",
+           "progress_bar"]
+
+_PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
+
+
+@dataclasses.dataclass
+class Program:
+    """Where a program comes from: a file path, or text given directly."""
+
+    name: str
+    path: Path | None = None
+    text: str | None = None
+    preprocessed: bool = False  # the preprocess stage ran (and checked how the file ends)
+
+    def chunks(self, diagnostics: Diagnostics | None = None) -> Iterator[bytes]:
+        """The program's chunks of whole lines; problems with the file go to ``diagnostics``, if given."""
+        return iter_lines(self.path if self.path is not None else self.text, diagnostics)
+
+    def head(self, size: int = 65536) -> str:
+        if self.text is not None:
+            return self.text[:size]
+        for chunk in self.chunks():
+            return chunk[:size].decode("utf-8", "replace")
+        return ""
+
+
+def as_program(source: str | os.PathLike) -> Program:
+    """A path names a file; a string with a newline, or no such file, is program text."""
+    if isinstance(source, os.PathLike):
+        if not os.path.isfile(source):
+            raise FileNotFoundError(f"no such program file: {os.fspath(source)!r}")
+        return Program(str(source), path=Path(source))
+    if not isinstance(source, str):
+        raise TypeError(f"expected a path or program text, not {type(source).__name__}")
+    if "\n" not in source and os.path.isfile(source):
+        return Program(source, path=Path(source))
+    if "\n" not in source and (os.sep in source or source.lower().endswith(_PROGRAM_SUFFIXES)):
+        raise FileNotFoundError(f"no such program file: {source!r}")
+    return Program("<string>", text=source)
+
+
+def resolve(program: Program, machine: str | MachineConfig | None, flavor: str | Flavor | None,
+            **machine_options) -> tuple[Flavor, MachineConfig, Detection | None]:
+    """Choose flavor and machine: explicit ones first, else detection.
+
+    Returns the flavor, the machine and the detection (None when the flavor
+    was given or came with the machine).
+    """
+    config = None
+    if isinstance(machine, MachineConfig):
+        config = machine
+    elif machine is not None:
+        config = load_machine(machine)
+    detection = None
+    if flavor is not None:
+        fl = load_flavor(flavor) if isinstance(flavor, (str, os.PathLike)) else flavor
+    elif config is not None:
+        fl = load_flavor(config.flavor)
+    else:
+        detection = detect_flavor(program.head(), program.name if program.path else None)
+        fl = load_flavor(detection.name)
+    if config is None:
+        config = load_machine(default_machine_for(fl.name))
+    if machine_options:
+        config = with_options(config, **machine_options)
+    return fl, config, detection
+
+
+def note_weak_detection(detection: Detection | None, diagnostics: Diagnostics) -> None:
+    """An info diagnostic naming the flavor detection chose, and why, when its evidence was thin."""
+    if detection is not None and detection.weak:
+        diagnostics.report(1, 1, f"flavor {detection.name!r} chosen on thin evidence ({'; '.join(detection.reasons)}); "
+                           "give the flavor (flavor=, --flavor) if the program is in another dialect", severity="info")
+
+
+def check_program_end(program: Program, table: CommandTable, n_lines: int, diagnostics: Diagnostics) -> None:
+    """A program file must end with M2/M30 or be wrapped in ``%`` lines (rs274's ``read_text``,
+    interp_read.cc); the error names the file's last line."""
+    if (table.name == NAME_ID["program_end"]).any() or n_lines == 0:
+        return
+    marks = []
+    for k, raw in enumerate(b"".join(program.chunks()).splitlines()):
+        stripped = raw.strip()
+        if stripped == b"%":
+            marks.append(k)
+        elif stripped and not marks:
+            break  # text before any '%': the program is not wrapped
+    if len(marks) >= 2:
+        return
+    diagnostics.report(n_lines, 1, "File ended with no percent sign" + (" or program end (M2 or M30)" * (not marks)),
+                       kind="machine")
+
+
+def quote_diagnostics(diagnostics: Diagnostics, program: Program, limit: int = 1000) -> None:
+    """Fill in the source text of diagnostics that were made without it (from the file each names)."""
+    wanted: dict[str, set[int]] = {}
+    for d in diagnostics.items[:limit]:
+        if not d.text:
+            wanted.setdefault(d.file, set()).add(d.line)
+    found: dict[tuple[str, int], str] = {}
+    for file, lines in wanted.items():
+        source = program if file == diagnostics.file else Program(file, path=Path(file))
+        if source.path is not None and not source.path.is_file():
+            continue
+        line_no = 0
+        for chunk in source.chunks():
+            for raw in chunk.split(b"\n")[:-1]:
+                line_no += 1
+                if line_no in lines:
+                    found[file, line_no] = raw[:200].decode("utf-8", "replace").rstrip("\r")
+            if line_no >= max(lines):
+                break
+    diagnostics.items = [
+        dataclasses.replace(d, text=found.get((d.file, d.line), "")) if not d.text else d for d in diagnostics.items
+    ]
+
+
+def progress_bar(program: Program, enabled: bool):
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    total = program.path.stat().st_size if program.path is not None and program.path.suffix != ".gz" else None
+    return tqdm(total=total, unit="B", unit_scale=True, desc=Path(program.name).name, file=sys.stderr,
+                leave=False)
