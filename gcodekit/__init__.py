@@ -9,19 +9,9 @@ The pipeline runs text -> blocks -> commands -> machine states -> operation
 10.0
 """
 
-from .model.operation import (
-    AdditiveOperation,
-    AdditiveProcessData,
-    Operation,
-    ProcessData,
-    SubtractiveOperation,
-    SubtractiveProcessData,
-)
-from .additive import AdditivePart, Bead
-from .export.vtk import VTKExporter
 from . import visualize
-from .analysis import export_event_series_from_gcode, gcode_dataframe_to_event_series
-from .export.gcode import GcodeExporter
+from .additive import AdditivePart, Bead
+from .analysis import time_by, velocity_profile
 from .emulate.presets import MachineConfig, list_machines, load_machine
 from .errors import (
     ConfigError,
@@ -31,17 +21,45 @@ from .errors import (
     GcodeLimitError,
     GcodeMachineError,
     GcodeSyntaxError,
+    MissingDependencyError,
+    NothingToShowError,
+    ProgramFileError,
+)
+from .export.events import event_series, gcode_dataframe_to_event_series
+from .export.gcode import GcodeExporter
+from .export.vtk import VTKExporter
+from .limits import MAX_ITERATIONS, MAX_MOTIONS
+from .model.operation import (
+    AdditiveOperation,
+    AdditiveProcessData,
+    Operation,
+    ProcessData,
+    SubtractiveOperation,
+    SubtractiveProcessData,
 )
 from .parse import GcodeParser
-from .pipeline import emulate_operation, gcode_file_to_dataframe, gcode_to_operation, parse_program
+from .pipeline import (
+    emulate_operation,
+    export_event_series_from_gcode,
+    gcode_file_to_dataframe,
+    gcode_to_operation,
+    parse_program,
+    transpile_program,
+)
+from .plan.profile import BAAMMotionProfile, MotionProfile
+from .schema import COLUMNS
 from .syntax import detect_flavor, list_flavors, load_flavor
 
+#: The one version string: pyproject.toml reads it from here.
 __version__ = "0.1.0"
 
 __all__ = [
-    "AdditiveOperation", "AdditivePart", "AdditiveProcessData", "Bead", "VTKExporter", "ConfigError", "GcodeExporter", "Diagnostic", "GcodeError",
-    "GcodeExpressionError", "GcodeLimitError", "GcodeMachineError", "GcodeParser", "GcodeSyntaxError",
-    "MachineConfig", "Operation", "ProcessData", "SubtractiveOperation", "SubtractiveProcessData",
-    "detect_flavor", "emulate_operation", "export_event_series_from_gcode", "gcode_dataframe_to_event_series", "gcode_file_to_dataframe", "gcode_to_operation", "list_flavors",
-    "list_machines", "load_flavor", "load_machine", "parse_program",
+    "AdditiveOperation", "AdditivePart", "AdditiveProcessData", "BAAMMotionProfile", "Bead", "COLUMNS", "ConfigError",
+    "Diagnostic", "GcodeError", "GcodeExporter", "GcodeExpressionError", "GcodeLimitError", "GcodeMachineError",
+    "GcodeParser", "GcodeSyntaxError", "MAX_ITERATIONS", "MAX_MOTIONS", "MachineConfig", "MissingDependencyError",
+    "MotionProfile", "NothingToShowError", "Operation", "ProcessData", "ProgramFileError", "SubtractiveOperation",
+    "SubtractiveProcessData", "VTKExporter", "detect_flavor", "emulate_operation", "event_series",
+    "export_event_series_from_gcode", "gcode_dataframe_to_event_series", "gcode_file_to_dataframe",
+    "gcode_to_operation", "list_flavors", "list_machines", "load_flavor", "load_machine", "parse_program", "time_by",
+    "transpile_program", "velocity_profile", "visualize",
 ]

@@ -198,36 +198,11 @@ def _load(path: str, args: argparse.Namespace):
                               max_motions=args.max_motions, max_iterations=args.max_iterations)
 
 
-def summary(op) -> dict[str, Any]:
-    """The ``info`` record of an emulated operation (what ``--json`` prints)."""
-    stats = op.get_statistics()
-    bounds = stats["bounds"] or {"min": [None] * 3, "max": [None] * 3}
-    return {
-        "file": op.file,
-        "flavor": op.flavor.name,
-        "machine": op.machine.name,
-        "lines": stats["lines"],
-        "commands": stats["commands"],
-        "moves": stats["moves"],
-        "bounds": bounds,
-        "distance_mm": stats["distance_mm"],
-        "time_s": stats["time_s"],
-        "planner": op.machine.planner or None,
-        "layers": stats["layers"],
-        "filament_mm": stats["filament_mm"],
-        "filament_convention": stats["filament_convention"],
-        "filament_pushed_mm": stats["filament_pushed_mm"],
-        "tools": stats["tools"],
-        "diagnostics": [d.as_dict() for d in op.diagnostics],
-        "diagnostics_dropped": op.diagnostics.dropped,
-    }
-
-
 def _info(args: argparse.Namespace) -> int:
     records = []
     for path in args.files:
         try:
-            records.append(summary(_load(path, args)))
+            records.append(_load(path, args).summary())
         except (GcodeError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
             if len(args.files) == 1:
                 raise
@@ -255,7 +230,8 @@ def _json_safe(value):
 def _text(r: dict[str, Any]) -> str:
     if "error" in r:
         return f"{r['file']}\n  error: {r['error']}\n"
-    m, d, b = r["moves"], r["distance_mm"], r["bounds"]
+    m, d = r["moves"], r["distance_mm"]
+    b = r["bounds"] or {"min": [None] * 3, "max": [None] * 3}
     fmt = lambda v: "-" if v is None else f"{v:.3f}"  # noqa: E731
     lines = [
         r["file"],

@@ -50,13 +50,11 @@ def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
     The work is the depositing moves from the first layer on (start-code purge
     lines are not the part) or, for a mill, the feed moves.
     """
-    from .analysis import depositing_of, layers
-
     w = op.waypoints
     moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
     moving[:1] = False  # a move is drawn from the waypoint before it
     if _is_additive(op):
-        work = depositing_of(op) & (layers(op) >= 0)
+        work = op.depositing & (op.layers >= 0)
     else:
         work = np.asarray(w["motion"]) >= 2
     work &= moving
@@ -70,17 +68,15 @@ def waypoint_scalars(op: "Operation", scalars: str) -> tuple[np.ndarray, list[st
     move's length over its planned time, mm/s), ``layer``, ``time`` (elapsed,
     s), or any waypoint column (``feed``, ``tool``, ``laser``, ``z`` ...).
     """
-    from . import analysis
-
     w = op.waypoints
     if scalars == "feature":
-        names, codes = np.unique(analysis.features(op).astype(str), return_inverse=True)
+        names, codes = np.unique(op.features.astype(str), return_inverse=True)
         return codes.astype(np.int32), [n or "(none)" for n in names.tolist()]
     if scalars == "speed":
         d, t = np.asarray(w["distance"], float), np.nan_to_num(np.asarray(w["time"], float))
         return np.divide(d, t, out=np.zeros_like(d), where=t > 0), None
     if scalars == "layer":
-        return analysis.layers(op), None
+        return op.layers, None
     if scalars in ("time", "elapsed_time"):
         return op.elapsed_time(), None
     check_choice("scalars", scalars, [*NAMED_SCALARS, *sorted(k for k in w if k not in NAMED_SCALARS and k != "command")])
@@ -149,9 +145,7 @@ def _glyphs(pv, mesh: "pv.PolyData", size: float) -> "pv.PolyData":
 
 def default_scalars(op: "Operation") -> str:
     """``feature`` when the program names its features, else ``layer`` (additive) or ``feed``."""
-    from .analysis import features
-
-    if op.flavor is not None and op.flavor.feature_comment and (features(op) != "").any():
+    if op.flavor is not None and op.flavor.feature_comment and (op.features != "").any():
         return "feature"
     return "layer" if _is_additive(op) else "feed"
 
@@ -250,7 +244,7 @@ def plot_layer(source: "Operation | AdditivePart", layer: int, *, ax: "Axes | No
     ----------
     source : Operation or AdditivePart
     layer : int
-        0-based, as :func:`gcodekit.analysis.layers` numbers them.
+        0-based, as ``Operation.layers`` numbers them.
     ax : matplotlib Axes, default: a new figure's
 
     Returns
@@ -262,9 +256,7 @@ def plot_layer(source: "Operation | AdditivePart", layer: int, *, ax: "Axes | No
     op = getattr(source, "operation", source)
     if not _is_emulated(op):
         raise ValueError(f"{op.file}: plot_layer needs an emulated operation (use gcode_to_operation)")
-    from . import analysis
-
-    in_layer = (source.waypoint_layer if hasattr(source, "waypoint_layer") else analysis.layers(op)) == layer
+    in_layer = (source.waypoint_layer if hasattr(source, "waypoint_layer") else op.layers) == layer
     work, travel = move_masks(op)
     if not (work & in_layer).any():
         raise NothingToShowError(f"{op.file}: layer {layer} has no deposition moves")

@@ -69,7 +69,7 @@ def test_every_stage_reads_back_without_errors(path):
 
 
 def test_last_stage_vocabulary_and_line_numbers():
-    t = Transpiler("G21 G0 X0 Y0 Z5\nG55 G81 X10 Y10 Z-2 R1 F100\nX20\nG80\nG91 G1 X5\nM2\n", "linuxcnc",
+    t = gcodekit.transpile_program("G21 G0 X0 Y0 Z5\nG55 G81 X10 Y10 Z-2 R1 F100\nX20\nG80\nG91 G1 X5\nM2\n", "linuxcnc",
                    work_offsets={"G55": (100.0, 0.0, 0.0)})
     lines = [line for line in t.stage(6).splitlines() if not line.startswith("(")]
     assert lines[0] == "G21" and lines[-1] == "N6 M2"  # it names its units, and the program still ends
@@ -82,7 +82,7 @@ def test_last_stage_vocabulary_and_line_numbers():
 
 
 def test_stage_1_converts_units():
-    t = Transpiler("G20 G91 G0 X1\nG1 X0.5 F10\n", "linuxcnc")
+    t = gcodekit.transpile_program("G20 G91 G0 X1\nG1 X0.5 F10\n", "linuxcnc")
     assert "N1 G0 X25.4" in t.stage(1) and "N2 G1 F254 X12.7" in t.stage(1)
 
 
@@ -91,7 +91,7 @@ def test_stage_1_converts_units():
     ("ger", "G21 G91\nG16\nG01 X10 Y90 F100\nX10 Y0\nG15\nG01 X1 Y1\n"),
 ])
 def test_g16_polar_moves_alike_at_every_stage(flavor, text):
-    t = Transpiler(text, flavor, work_offsets={"G55": (100.0, 50.0, 0.0)})
+    t = gcodekit.transpile_program(text, flavor, work_offsets={"G55": (100.0, 50.0, 0.0)})
     reference = path_of(t.op)
     for k in STAGES:
         out = t.stage(k)
@@ -132,7 +132,7 @@ M2
 
 def test_cycles_move_alike_at_every_stage():
     """Cycle words (drilling's X Y Z R, a lathe cycle's point and profile, G76's) take the units and offsets."""
-    t = Transpiler(CYCLES_UNDER_OFFSETS, "linuxcnc")
+    t = gcodekit.transpile_program(CYCLES_UNDER_OFFSETS, "linuxcnc")
     reference = path_of(t.op)
     assert not t.op.diagnostics.items
     for k in STAGES:

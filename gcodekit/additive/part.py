@@ -32,6 +32,7 @@ import numpy as np
 
 from ..emulate.arcs import waypoint_arc_points
 from ..errors import ConfigError
+from ..model import derived
 from .bead import Bead
 
 if TYPE_CHECKING:
@@ -84,8 +85,6 @@ class AdditivePart:
 
     def __init__(self, operation: "Operation", bead: Bead | None = None, *,
                  layer_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)):
-        from ..analysis import depositing, layers
-
         if operation.waypoints is None:
             raise ValueError(f"{operation.file}: an AdditivePart needs an emulated operation (use gcode_to_operation)")
         normal = np.asarray(layer_normal, float)
@@ -98,9 +97,9 @@ class AdditivePart:
         along_z = np.allclose(self.layer_normal, (0.0, 0.0, 1.0))
         height = np.asarray(w["z"], float) if along_z else sum(
             c * np.asarray(w[k], float) for c, k in zip(self.layer_normal, "xyz") if c)
-        self.waypoint_layer = layers(operation, None if along_z else height)
+        self.waypoint_layer = operation.layers if along_z else derived.layers(operation, height)
         moves = np.flatnonzero((np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0))
-        deposit = depositing(w, self.extruder_type == "screw")[moves]
+        deposit = derived.depositing(w, self.extruder_type == "screw")[moves]
         layer = self.waypoint_layer[moves]
         # a segment ends where the move kind or the layer changes
         first = np.r_[True, (deposit[1:] != deposit[:-1]) | (layer[1:] != layer[:-1])] if moves.size else np.zeros(0, bool)

@@ -91,9 +91,7 @@ def filament_used(op: "Operation", convention: str | None = None) -> float:
         return float(e.sum())
     if convention == "positive":
         return float(e[e > 0].sum())
-    from ..analysis import layers
-
-    first = np.flatnonzero(layers(op) >= 0)
+    first = np.flatnonzero(op.layers >= 0)
     start = int(first[0]) if first.size else 0
     drawn = np.cumsum(e)
     before = float(np.max(drawn[:start], initial=0.0))

@@ -29,14 +29,19 @@ from ..parse.calls import call_bead_area
 from ..parse.commands import Command, Kind
 from ..parse.table import MOTION_NAMES, NAME_ID, CommandTable
 from ..syntax.flavor import code_label
-from ..schema import WAYPOINT_COLUMNS
+from ..schema import COLUMNS, WAYPOINT_COLUMNS
 from ..units import MM_PER_INCH
+from . import derived, statistics
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from ..syntax import Flavor
     from ..emulate.presets import MachineConfig
+
+
+#: Columns only a planned operation has
+_PLANNED = ("start_v", "cruise_v", "end_v", "accel")
 
 
 @dataclass(frozen=True)
@@ -148,6 +153,7 @@ class Operation:
                  n_lines: int = 0, max_motions: int = MAX_MOTIONS):
         self.table = commands
         self.max_motions = max_motions
+        self._derived: dict[str, Any] = {}
         self.waypoints = waypoints
         self.file = file
         self.flavor = flavor
@@ -156,6 +162,81 @@ class Operation:
         self.n_lines = n_lines
         self._elapsed: np.ndarray | None = None
         self.plan = None  # (PlannedMoves, PlanResult) once a motion planner has run
+
+    @property
+    def waypoints(self) -> dict[str, np.ndarray] | None:
+        """The waypoint columns (see :attr:`columns`); None before emulation."""
+        return self._waypoints
+
+    @waypoints.setter
+    def waypoints(self, columns: dict[str, np.ndarray] | None) -> None:
+        self._waypoints = columns
+        self._derived.clear()  # layers, features ... belong to the old columns
+
+    # -- derived columns, computed once --------------------------------------------
+
+    def _kept(self, name: str, make) -> Any:
+        if name not in self._derived:
+            self._derived[name] = make()
+        return self._derived[name]
+
+    @property
+    def depositing(self) -> np.ndarray:
+        """Per waypoint, whether the step lays material (see :mod:`gcodekit.model.derived`).
+
+        Examples
+        --------
+        >>> import gcodekit
+        >>> op = gcodekit.gcode_to_operation("M83\\nG1 X10 E1 F600\\nG1 X20\\n", "marlin", plan=False)
+        >>> op.depositing.tolist()
+        [False, True, False]
+        """
+        return self._kept("depositing", lambda: derived.depositing_of(self))
+
+    @property
+    def features(self) -> np.ndarray:
+        """Per waypoint, the slicer feature (``;TYPE:``) or DED fraction in force, ``""`` before the first."""
+        return self._kept("features", lambda: derived.features(self))
+
+    @property
+    def layers(self) -> np.ndarray:
+        """Per waypoint, its layer (0 first, -1 before the first; see :mod:`gcodekit.model.derived`).
+
+        Examples
+        --------
+        >>> import gcodekit
+        >>> op = gcodekit.gcode_to_operation("M83\\nG1 Z0.2 F600\\nG1 X10 E1\\nG1 Z0.4\\nG1 X0 E1\\n", "marlin", plan=False)
+        >>> op.layers.tolist(), op.n_layers  # a layer begins at its first extruding move
+        ([-1, -1, 0, 0, 1], 2)
+        """
+        return self._kept("layers", lambda: derived.layers(self).astype(np.int32))
+
+    @property
+    def n_layers(self) -> int:
+        """How many layers: the last layer plus one (0 for a program that lays nothing)."""
+        return int(self.layers.max()) + 1 if self.layers.size else 0
+
+    @property
+    def columns(self) -> "pd.DataFrame":
+        """The schema of :meth:`to_dataframe`'s columns: name, unit, dtype and meaning.
+
+        Examples
+        --------
+        >>> import gcodekit
+        >>> op = gcodekit.gcode_to_operation("G1 X1 F600\\n", "linuxcnc", plan=False)
+        >>> op.columns.loc["feed"].tolist()
+        ['mm/min', 'float64', 'feed rate in force']
+        """
+        import pandas as pd
+
+        shown = [c for c in COLUMNS.values() if self.plan is not None or c.name not in _PLANNED]
+        return pd.DataFrame({"unit": [c.unit for c in shown], "dtype": [c.dtype for c in shown],
+                             "meaning": [c.meaning for c in shown]},
+                            index=pd.Index([c.name for c in shown], name="column"))
+
+    def summary(self) -> dict[str, Any]:
+        """The one summary record (see :func:`gcodekit.model.statistics.summary`)."""
+        return statistics.summary(self)
 
     # -- the seed's object API ---------------------------------------------------
 
@@ -255,9 +336,7 @@ class Operation:
         """
         if not self._require_emulation("get_statistics()"):
             return None
-        from ..analysis import operation_statistics
-
-        return operation_statistics(self)
+        return statistics.operation_statistics(self)
 
     # -- tables -------------------------------------------------------------------
 
@@ -310,6 +389,7 @@ class Operation:
             data.update(waypoint_speeds(self))
         data["elapsed_time"] = self.elapsed_time()
         data["start_time"] = data["elapsed_time"] - np.nan_to_num(np.asarray(w["time"], float))
+        data["layer"], data["feature"], data["depositing"] = self.layers, self.features, self.depositing
         return pd.DataFrame(data, copy=False)
 
     def _codes(self) -> np.ndarray:

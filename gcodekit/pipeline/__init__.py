@@ -40,8 +40,10 @@ from .source import program_blocks, restore_line_numbers
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate_operation", "resolve",
-           "as_program", "Program"]
+    from ..transpile import Transpiler
+
+__all__ = ["gcode_to_operation", "gcode_file_to_dataframe", "parse_program", "emulate_operation",
+           "export_event_series_from_gcode", "transpile_program", "resolve", "as_program", "Program"]
 
 
 def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None, *,
@@ -190,3 +192,24 @@ def gcode_file_to_dataframe(source: str | os.PathLike, machine: str | MachineCon
                             **kwargs) -> "pd.DataFrame":
     """The waypoint table of a program as a DataFrame (see ``Operation.to_dataframe``)."""
     return gcode_to_operation(source, machine, **kwargs).to_dataframe()
+
+
+def export_event_series_from_gcode(path: str | os.PathLike, output_path: str | os.PathLike, *,
+                                   source: str = "material", machine: str | MachineConfig | None = None,
+                                   **options) -> "pd.DataFrame":
+    """Write the Abaqus event series of a program (see :func:`gcodekit.export.events.write_event_series`)."""
+    from ..export.events import write_event_series
+
+    return write_event_series(gcode_to_operation(path, machine, **options), output_path, source=source)
+
+
+def transpile_program(source: str | os.PathLike, machine: str | MachineConfig | None = None, *,
+                      precision: int = 4, **options) -> "Transpiler":
+    """The staged simplification of a program given by path or text (see :class:`gcodekit.transpile.Transpiler`).
+
+    ``options`` go to :func:`gcode_to_operation` (``flavor``, ``tool_table``, ...);
+    the transpiler works from the emulated, unplanned program.
+    """
+    from ..transpile import Transpiler
+
+    return Transpiler(gcode_to_operation(source, machine, plan=False, **options), precision=precision)

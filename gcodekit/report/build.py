@@ -1,8 +1,8 @@
 """Report stage: the numbers of one program's report, as plain data.
 
 Everything the page shows besides pictures comes from here, so the HTML page,
-the PDF and the notebook agree: the summary is the Operation's own statistics
-(planned time is ``op.get_statistics()["time_s"]``), the breakdown is
+the PDF and the notebook agree: the summary is the Operation's one summary
+record (``op.summary()``, what ``gcodekit info --json`` prints), the breakdown is
 ``op.time_by``, and mill programs add the transpiler's stage table and text.
 
 Examples
@@ -46,35 +46,11 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
     dict with ``name``, ``summary``, ``breakdown`` (``by``, ``rows``), ``layers``
     (per-layer rows, additive only), ``stages`` and ``toolpath`` (mill only).
     """
-    stats = op.get_statistics()
-    machine = op.machine
-    additive = machine is not None and machine.process == "additive"
-    summary: dict[str, Any] = {
-        "file": op.file,
-        "machine": machine.name if machine else None,
-        "process": machine.process if machine else "generic",
-        "planner": (machine.planner or None) if machine else None,
-        "flavor": op.flavor.name if op.flavor else None,
-        "lines": stats["lines"],
-        "moves": stats["moves"],
-        "distance_mm": stats["distance_mm"],
-        "time_s": stats["time_s"],
-        "layers": stats["layers"],
-        "bounds": stats["bounds"],
-        "tools": stats["tools"],
-        "filament_mm": stats["filament_mm"],
-        "volume_mm3": None,
-        "mass_g": None,
-        # a problem in a subroutine file says which file
-        "diagnostics": [{**d.as_dict(), "elsewhere": Path(d.file).name if d.file != op.diagnostics.file else ""}
-                        for d in list(op.diagnostics)[:MAX_DIAGNOSTICS]],
-        "diagnostics_total": len(op.diagnostics) + op.diagnostics.dropped,
-        "errors": sum(1 for d in op.diagnostics if d.severity == "error"),
-    }
-    if additive and stats["filament_mm"]:
-        volume = stats["filament_mm"] * op.filament_area
-        summary["volume_mm3"] = volume
-        summary["mass_g"] = volume / 1000.0 * machine.filament_density  # density in g/cm^3
+    summary = op.summary()
+    additive = summary["process"] == "additive"
+    # the page lists the first diagnostics, each saying which file when it is a subroutine file's
+    summary["diagnostics"] = [{**d, "elsewhere": Path(d["file"]).name if d["file"] != op.diagnostics.file else ""}
+                              for d in summary["diagnostics"][:MAX_DIAGNOSTICS]]
     data: dict[str, Any] = {"name": Path(op.file).name, "summary": summary,
                             "breakdown": breakdown(op), "layers": None, "stages": None, "toolpath": None}
     if additive:
@@ -98,9 +74,7 @@ def breakdown(op: "Operation") -> dict[str, Any]:
 
     Rows that took no time and moved nowhere (a tool loaded but never used) are left out.
     """
-    from ..analysis import features
-
-    by = "feature" if np.any(features(op) != "") else "tool"
+    by = "feature" if np.any(op.features != "") else "tool"
     table = op.time_by(by)
     table = table[(table["time_s"] > 0) | (table["distance_mm"] > 0)]
     rows = []

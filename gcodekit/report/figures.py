@@ -16,7 +16,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..analysis import depositing_of, features, layers
 from ..emulate.arcs import PLANES, sweep
 
 if TYPE_CHECKING:
@@ -69,17 +68,17 @@ def toolpath_segments(op: "Operation") -> Segments:
     xyz = np.column_stack([w["x"], w["y"], w["z"]]).astype(float)
     prev = np.vstack([xyz[:1], xyz[:-1]])
     moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
-    keep = depositing_of(op) if additive else moving
+    keep = op.depositing if additive else moving
     idx = np.flatnonzero(keep)
     labels = None
     if additive:
-        names = features(op)
+        names = op.features
         if np.any(names != ""):
             labels, value = np.unique(names, return_inverse=True)
             labels = [str(x) or "(no feature)" for x in labels]
         else:
             value = np.asarray(w["feed"], float) / 60.0
-        layer = layers(op)
+        layer = op.layers
     else:
         value = np.asarray(w["feed"], float) / 60.0
         layer = np.full(xyz.shape[0], -1)

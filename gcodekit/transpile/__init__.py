@@ -27,8 +27,8 @@ waypoints; stages 1-3 rewrite the words of each command.
 
 Examples
 --------
->>> from gcodekit.transpile import Transpiler
->>> t = Transpiler("G20 G91 G0 X1\\nX1\\nM2\\n", machine="linuxcnc")
+>>> import gcodekit
+>>> t = gcodekit.transpile_program("G20 G91 G0 X1\\nX1\\nM2\\n", machine="linuxcnc")
 >>> print(t.stage(6))
 (gcodekit transpile stage 6: machine units mm, absolute machine coordinates)
 G21
@@ -40,6 +40,8 @@ N3 M2
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..emulate.arcs import PLANES
@@ -49,6 +51,9 @@ from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
 from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, NAME_ID, NAMES, PROFILE_TAG
 from .cycle_words import cycle_offset, diameter_words, lathe_defaults, length_words, level_words, rewrite_profile
+
+if TYPE_CHECKING:
+    from ..model.operation import Operation
 
 STAGES = tuple(range(7))
 STAGE_NAMES = ("expanded", "units", "offsets", "polar", "absolute", "cutter compensation", "canned cycles")
@@ -73,21 +78,18 @@ class Transpiler:
 
     Parameters
     ----------
-    source : path, program text or Operation
-    machine, flavor : as for :func:`gcodekit.gcode_to_operation`
+    operation : Operation
+        The emulated program (:func:`gcodekit.gcode_to_operation`; for a
+        path or text in one call, :func:`gcodekit.transpile_program`).
     precision : int, default: 4
         Digits after the decimal point in the output.
     """
 
-    def __init__(self, source, machine: str | None = None, *, flavor: str | None = None, precision: int = 4,
-                 **options):
-        from ..model.operation import Operation
-        from ..pipeline import gcode_to_operation
-
-        if isinstance(source, Operation):
-            self.op = source
-        else:
-            self.op = gcode_to_operation(source, machine, flavor=flavor, plan=False, **options)
+    def __init__(self, operation: "Operation", *, precision: int = 4):
+        if getattr(operation, "waypoints", None) is None:
+            raise TypeError("Transpiler needs an emulated Operation (gcodekit.gcode_to_operation); "
+                            "gcodekit.transpile_program reads a path or text")
+        self.op = operation
         self.precision = precision
         w = self.op.waypoints
         arcs = np.asarray(w["motion"]) >= 3
@@ -134,10 +136,12 @@ class Transpiler:
         return "\n".join(lines) + "\n"
 
     def commands(self, k: int):
-        """Stage ``k`` read back as typed commands."""
-        from ..pipeline import parse_program
+        """Stage ``k`` read back as typed commands (its text is plain RS274NGC)."""
+        from ..model.operation import Operation
+        from ..parse import GcodeParser
+        from ..read import read_text
 
-        return parse_program(self.stage(k), flavor="rs274ngc").commands
+        return Operation(GcodeParser("rs274ngc").parse(read_text(self.stage(k), "rs274ngc"))).commands
 
     def summary(self) -> list[dict]:
         """Per stage: its name and how many lines and motion lines it has."""
@@ -321,9 +325,4 @@ def _paren(text: str) -> str:
     return text.replace("(", "[").replace(")", "]")
 
 
-def translate(source, stage: int = 6, machine: str | None = None, **options) -> str:
-    """Stage ``stage`` of a program as G-code text (see :class:`Transpiler`)."""
-    return Transpiler(source, machine, **options).stage(stage)
-
-
-__all__ = ["Transpiler", "translate", "STAGES", "STAGE_NAMES"]
+__all__ = ["Transpiler", "STAGES", "STAGE_NAMES"]

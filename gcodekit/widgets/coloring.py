@@ -60,11 +60,9 @@ class Coloring:
 
 def choices(path: "Toolpath") -> list[str]:
     """The colourings a program offers: the named ones it has data for, then its waypoint columns."""
-    from ..analysis import features
-
     op = path.op
     named = []
-    if op.flavor is not None and op.flavor.feature_comment and (features(op) != "").any():
+    if op.flavor is not None and op.flavor.feature_comment and (op.features != "").any():
         named.append("feature")
     named += ["speed", "feed"]
     if path.group_by == "layer":

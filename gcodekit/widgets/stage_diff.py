@@ -114,9 +114,12 @@ class StageDiff(PictureDisplay):
         self._options = options
         self.name = Path(program).name if isinstance(program, (str, Path)) and "\n" not in str(program) else "program"
         try:
+            from ..model.operation import Operation
+            from ..pipeline import transpile_program
             from ..transpile import Transpiler
 
-            self.transpiler = Transpiler(program, machine, **options)
+            self.transpiler = Transpiler(program) if isinstance(program, Operation) else transpile_program(
+                program, machine, **options)
             if not np.any(np.asarray(self.transpiler.op.waypoints["motion"]) > 0):
                 self.error = f"{self.transpiler.op.file}: the program has no motions to translate"
         except Exception as exc:  # unreadable input: a message in the widget, not a traceback

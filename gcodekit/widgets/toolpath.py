@@ -197,9 +197,7 @@ def _command_rows(op: "Operation") -> np.ndarray:
 def _group_keys(op, rows, work, group_by, waypoint_layer) -> tuple[np.ndarray, list[str]]:
     """Group of each move (non-decreasing) and the group labels."""
     if group_by == "layer":
-        from ..analysis import layers
-
-        layer = (layers(op) if waypoint_layer is None else np.asarray(waypoint_layer))[rows]
+        layer = (op.layers if waypoint_layer is None else np.asarray(waypoint_layer))[rows]
         # start code before the first layer is drawn with layer 0; layers never go back
         key = np.maximum.accumulate(np.maximum(layer, 0))
         return key, [f"layer {k}" for k in range(int(key[-1]) + 1)]

@@ -1,0 +1,165 @@
+"""The package's imports run one way, down the pipeline, and never in a circle.
+
+Every ``import`` in gcodekit, at module level or inside a function, is read
+from the source (``if TYPE_CHECKING:`` blocks are for type checkers and
+never run, so they do not count).  A module may import its own folder and
+the stages before it (docs/architecture.md); the one exception is the
+Operation's convenience methods (``op.plot()``, ``op.to_vtk()``, ...), which
+import an output inside the call.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1] / "gcodekit"
+
+#: The stages in order; a module's stage is the longest prefix that names it.
+STAGES: list[tuple[str, ...]] = [
+    ("gcodekit.errors", "gcodekit.limits", "gcodekit.units", "gcodekit.schema", "gcodekit.memory"),
+    ("gcodekit.syntax",),
+    ("gcodekit.preprocess",),
+    ("gcodekit.read",),
+    ("gcodekit.parse",),
+    ("gcodekit.emulate",),
+    ("gcodekit.plan",),
+    ("gcodekit.model",),
+    ("gcodekit.analysis", "gcodekit.additive", "gcodekit.export", "gcodekit.visualize", "gcodekit.transpile"),
+    ("gcodekit.pipeline",),
+    ("gcodekit.report", "gcodekit.widgets", "gcodekit.cli", "gcodekit.testing", "gcodekit"),
+]
+#: Where an import may reach a later stage: the Operation's convenience methods, lazily, into the outputs.
+CONVENIENCE = ("gcodekit.model.operation", 8)
+
+
+def modules() -> dict[str, Path]:
+    found = {}
+    for path in PACKAGE.rglob("*.py"):
+        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        found[name] = path
+    return found
+
+
+def stage_of(module: str) -> int:
+    best, rank = -1, -1
+    for k, names in enumerate(STAGES):
+        for name in names:
+            if (module == name or module.startswith(name + ".")) and len(name) > best:
+                best, rank = len(name), k
+    assert rank >= 0, f"{module} belongs to no stage: add it to STAGES and docs/architecture.md"
+    return rank
+
+
+def _type_checking_only(node: ast.If) -> bool:
+    test = node.test
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def imports(name: str, path: Path, known: dict[str, Path]) -> list[tuple[str, int, bool]]:
+    """(imported module, line, inside a function) of every import that runs."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = []
+
+    def visit(node: ast.AST, in_function: bool) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and _type_checking_only(child):
+                for other in child.orelse:
+                    visit(other, in_function)
+                continue
+            inside = in_function or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef))
+            if isinstance(child, ast.Import):
+                found.extend((a.name, child.lineno, inside) for a in child.names if a.name.startswith("gcodekit"))
+            elif isinstance(child, ast.ImportFrom):
+                base = child.module or ""
+                if child.level:
+                    anchor = package.split(".")[: len(package.split(".")) - (child.level - 1)]
+                    base = ".".join(anchor + ([child.module] if child.module else []))
+                if base.startswith("gcodekit"):
+                    for alias in child.names:
+                        target = f"{base}.{alias.name}"
+                        found.append((target if target in known else base, child.lineno, inside))
+            visit(child, inside)
+
+    visit(tree, False)
+    return found
+
+
+def edges() -> list[tuple[str, str, int, bool]]:
+    known = modules()
+    out = []
+    for name, path in sorted(known.items()):
+        for target, line, inside in imports(name, path, known):
+            while target not in known and "." in target:
+                target = target.rpartition(".")[0]
+            if target != name:
+                out.append((name, target, line, inside))
+    return out
+
+
+def allowed_upward(source: str, target: str, inside: bool) -> bool:
+    return inside and source == CONVENIENCE[0] and stage_of(target) == CONVENIENCE[1]
+
+
+def test_imports_run_down_the_pipeline():
+    wrong = [f"{s}:{line} imports {t} ({'inside a function' if inside else 'module level'}): stage "
+             f"{stage_of(s)} reaches stage {stage_of(t)}"
+             for s, t, line, inside in edges()
+             if stage_of(t) > stage_of(s) and not allowed_upward(s, t, inside)]
+    assert not wrong, "\n".join(wrong)
+
+
+def test_no_import_circles():
+    graph: dict[str, set[str]] = {}
+    for s, t, _, inside in edges():
+        if not allowed_upward(s, t, inside):
+            graph.setdefault(s, set()).add(t)
+    # a package's __init__ re-exporting its own modules is not a circle of ideas: leave those edges out
+    for s in list(graph):
+        graph[s] = {t for t in graph[s] if not (t.startswith(s + ".") and (PACKAGE / Path(*s.split(".")[1:]) / "__init__.py").exists())}
+    cycles = _cycles(graph)
+    assert not cycles, "import circles:\n" + "\n".join(" -> ".join(c) for c in cycles)
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+
+    def connect(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                connect(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for v in list(graph):
+        if v not in index:
+            connect(v)
+    return found
+
+
+def test_the_check_sees_function_level_imports():
+    """The walker must not miss an import hidden in a function (the kind that once made circles)."""
+    found = {(s, t) for s, t, _, inside in edges() if inside}
+    assert ("gcodekit.cli", "gcodekit.pipeline") in found
