@@ -29,7 +29,7 @@ from .export.events import event_series, gcode_dataframe_to_event_series
 from .export.gcode import GcodeExporter
 from .export.vtk import VTKExporter
 from .limits import MAX_ITERATIONS, MAX_MOTIONS
-from .model.operation import (
+from .model import (
     AdditiveOperation,
     AdditiveProcessData,
     Operation,

@@ -7,14 +7,9 @@ This package holds that object, the columns derived from it once and kept
 Outputs build on it; it builds on nothing after planning.
 """
 
-from .operation import (
-    AdditiveOperation,
-    AdditiveProcessData,
-    Operation,
-    ProcessData,
-    SubtractiveOperation,
-    SubtractiveProcessData,
-)
+from .operation import Operation
+from .process_data import AdditiveProcessData, ProcessData, SubtractiveProcessData
+from .processes import OPERATION_CLASSES, AdditiveOperation, SubtractiveOperation
 
-__all__ = ["AdditiveOperation", "AdditiveProcessData", "Operation", "ProcessData", "SubtractiveOperation",
-           "SubtractiveProcessData"]
+__all__ = ["AdditiveOperation", "AdditiveProcessData", "OPERATION_CLASSES", "Operation", "ProcessData",
+           "SubtractiveOperation", "SubtractiveProcessData"]

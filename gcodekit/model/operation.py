@@ -16,117 +16,32 @@ Examples
 
 from __future__ import annotations
 
+import os
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import Diagnostics
 from ..limits import MAX_MOTIONS
-from ..parse.calls import call_bead_area
 from ..parse.commands import Command, Kind
-from ..parse.table import MOTION_NAMES, NAME_ID, CommandTable
-from ..syntax.flavor import code_label
+from ..parse.table import MOTION_NAMES, CommandTable
 from ..schema import COLUMNS, WAYPOINT_COLUMNS
+from ..syntax.flavor import code_label
 from ..units import MM_PER_INCH
 from . import derived, statistics
+from .process_data import LazyList, ProcessData
 
 if TYPE_CHECKING:
     import pandas as pd
 
-    from ..syntax import Flavor
     from ..emulate.presets import MachineConfig
+    from ..syntax import Flavor
 
 
 #: Columns only a planned operation has
 _PLANNED = ("start_v", "cruise_v", "end_v", "accel")
-
-
-@dataclass(frozen=True)
-class ProcessData:
-    """What the machine model predicts at the end of one step.
-
-    Attributes
-    ----------
-    location : tuple of float
-        Machine X, Y, Z (mm) and A, B, C (degrees).
-    feed_rate : float
-        Feed rate in force, mm/min.
-    elapsed_time : float
-        Time since the program started, s.
-    distance : float
-        Path length of the step, mm.
-    duration : float
-        Time the step takes, s.
-    motion : str
-        ``""``, ``"rapid"``, ``"feed"``, ``"arc_cw"`` or ``"arc_ccw"``.
-    """
-
-    location: tuple[float, float, float, float, float, float]
-    feed_rate: float
-    elapsed_time: float
-    distance: float
-    duration: float
-    motion: str
-
-
-@dataclass(frozen=True)
-class AdditiveProcessData(ProcessData):
-    """Process data of a deposition step.
-
-    Attributes
-    ----------
-    deposited_volume : float
-        Material deposited by the step, mm^3 (filament length times its area).
-    bead_area : float
-        Cross-section of the deposited bead, mm^2 (volume over path length;
-        0 for travel).
-    extruder_type : str
-        ``"filament"`` for FFF, ``"screw"`` for pellet LFAM, ``"wire"`` for DED.
-    """
-
-    deposited_volume: float = 0.0
-    bead_area: float = 0.0
-    extruder_type: str = "filament"
-
-
-@dataclass(frozen=True)
-class SubtractiveProcessData(ProcessData):
-    """Process data of a milling step.
-
-    Attributes
-    ----------
-    spindle_speed : float
-        rpm, negative when counter-clockwise.
-    removed_volume : float or None
-        None until material removal is modelled.
-    """
-
-    spindle_speed: float = 0.0
-    removed_volume: float | None = None
-
-
-class _LazyList(Sequence):
-    """A read-only list whose items are made from columns when indexed."""
-
-    def __init__(self, size: int, make):
-        self._size = size
-        self._make = make
-
-    def __len__(self) -> int:
-        return self._size
-
-    def __getitem__(self, i):
-        if isinstance(i, slice):
-            return [self._make(k) for k in range(*i.indices(self._size))]
-        if not -self._size <= i < self._size:
-            raise IndexError(f"index {i} out of range for {self._size} items")
-        return self._make(i % self._size)
-
-    def __repr__(self) -> str:
-        return f"<{self._size} items>"
 
 
 class Operation:
@@ -243,7 +158,7 @@ class Operation:
     @property
     def commands(self) -> Sequence[Command]:
         """Typed commands, made when indexed."""
-        return _LazyList(len(self.table), self.table.command)
+        return LazyList(len(self.table), self.table.command)
 
     @property
     def process_data(self) -> Sequence[ProcessData]:
@@ -258,7 +173,7 @@ class Operation:
             k = i if mapping is None else int(mapping[i])
             return self.process_data_class(**self._process_fields(k, columns))
 
-        return _LazyList(len(self.table), make)
+        return LazyList(len(self.table), make)
 
     @property
     def emulated(self) -> bool:
@@ -360,6 +275,39 @@ class Operation:
 
         return velocity_profile(self)
 
+    # -- outputs, one call away (each imports its output module when called) ------
+
+    def plot(self, scalars: str | None = None, **options) -> np.ndarray | None:
+        """Draw the toolpath in 3D (see :func:`gcodekit.visualize.plot_operation` for the options).
+
+        Off-screen by default: returns the picture as an RGB array, and
+        writes it to ``screenshot=`` when given.
+        """
+        from ..visualize import plot_operation
+
+        return plot_operation(self, scalars, **options)
+
+    def to_vtk(self, path: str | os.PathLike | None = None, **options):
+        """The deposition paths as a PyVista mesh, written to ``path`` (``.vtp``/``.vtk``) when given.
+
+        Builds an :class:`~gcodekit.additive.AdditivePart` (``options`` such as
+        ``bead=`` and ``layer_normal=`` go to it) and exports it with
+        :class:`~gcodekit.export.vtk.VTKExporter`.
+        """
+        from ..additive import AdditivePart
+        from ..export.vtk import VTKExporter
+
+        part = AdditivePart(self, **options)
+        if path is not None:
+            VTKExporter.additive_part_to_vtk(part, path)
+        return VTKExporter.additive_part_to_polydata(part)
+
+    def to_gcode(self, flavor: str = "rs274ngc") -> str:
+        """The commands written back as G-code of ``flavor`` (see :class:`gcodekit.export.gcode.GcodeExporter`)."""
+        from ..export.gcode import GcodeExporter
+
+        return GcodeExporter(flavor).to_gcode(self)
+
     def to_dataframe(self) -> "pd.DataFrame":
         """One row per waypoint: command columns then process columns.
 
@@ -457,98 +405,3 @@ class Operation:
                 if key != "accel":
                     frame[key] = values[moved] * scale
         return pd.DataFrame(frame)
-
-
-class AdditiveOperation(Operation):
-    """An Operation of a deposition process (FFF, LFAM, DED)."""
-
-    process_data_class = AdditiveProcessData
-
-    def to_dataframe(self) -> "pd.DataFrame":
-        """As :meth:`Operation.to_dataframe`, plus ``deposited_volume`` (mm^3,
-        NaN where material is laid in an unknown amount) once emulated."""
-        frame = super().to_dataframe()
-        if self.waypoints is not None:
-            frame["deposited_volume"] = self.deposited_volumes()
-        return frame
-
-    @property
-    def filament_area(self) -> float:
-        d = self.machine.filament_diameter if self.machine else 1.75
-        return float(np.pi * d * d / 4.0)
-
-    def deposited_volumes(self) -> np.ndarray:
-        """Material laid by each waypoint (mm^3).
-
-        Filament machines: E pushed times the filament's cross-section.  Screw
-        extruders (BAAM): rpm x minutes x the screw's displacement per
-        revolution while the screw turns on a feed move; NaN when the machine
-        does not give its displacement.  Bead extruders (CEAD): the
-        programmed bead's width x height x the move's length while
-        deposition is on (``EM=1``).  Wire and powder (DED): unknown, NaN.
-        """
-        w = self.waypoints
-        kind = self.machine.extruder_type if self.machine else "filament"
-        if kind == "filament":
-            return np.asarray(w["de"], float) * self.filament_area
-        if kind == "screw":
-            turning = (np.asarray(w["spindle"]) > 0) & (np.asarray(w["motion"]) >= 2)
-            per_rev = self.machine.screw_displacement * 1000.0 or np.nan  # cm^3 -> mm^3
-            minutes = np.nan_to_num(np.asarray(w["time"], float)) / 60.0
-            return np.where(turning, np.asarray(w["spindle"], float) * minutes * per_rev, 0.0)
-        on = (np.asarray(w.get("laser", np.zeros(len(w["x"])))) == 1) & (np.asarray(w["motion"]) >= 2)
-        if kind == "bead":
-            return np.where(on, self.bead_areas() * np.asarray(w["distance"], float), 0.0)
-        return np.where(on, np.nan, 0.0)
-
-    def bead_areas(self) -> np.ndarray:
-        """Programmed bead cross-section in force at each waypoint (mm^2).
-
-        The last ``set_bead`` command (CEAD's ``EXTRUDERSPEED2(w, h, ..)``)
-        at or before the waypoint gives width x height; NaN before the
-        first one.
-
-        Examples
-        --------
-        >>> import gcodekit
-        >>> op = gcodekit.gcode_to_operation("EXTRUDERSPEED2(8,2,1400)\\nG1 F600 X10 EM=1\\nM30\\n", "cead")
-        >>> op.bead_areas().tolist()[-2:]
-        [16.0, 16.0]
-        """
-        w = self.waypoints
-        rows = np.asarray(w["command"]) if "command" in w else np.arange(len(w["x"]))
-        n = len(self.table)
-        calls = np.flatnonzero(np.asarray(self.table.name) == NAME_ID["set_bead"]) if n else np.zeros(0, int)
-        area_of_row = np.full(n, np.nan)
-        set_at = np.full(n, -1)
-        for row in calls.tolist():
-            area_of_row[row] = call_bead_area(self.table.named.get(row, ("", ""))[1])
-            set_at[row] = row
-        np.maximum.accumulate(set_at, out=set_at)  # the last call at or before each row
-        area = np.where(set_at >= 0, area_of_row[np.maximum(set_at, 0)], np.nan)
-        return area[rows] if n else np.full(len(rows), np.nan)
-
-    def _process_columns(self) -> dict[str, np.ndarray]:
-        return {**super()._process_columns(), "deposited_volume": self.deposited_volumes()}
-
-    def _process_fields(self, k: int, columns: dict[str, np.ndarray]) -> dict[str, Any]:
-        fields = super()._process_fields(k, columns)
-        volume = float(columns["deposited_volume"][k])
-        distance = fields["distance"]
-        fields.update(deposited_volume=volume, bead_area=volume / distance if distance > 0 and volume > 0 else 0.0,
-                      extruder_type=self.machine.extruder_type if self.machine else "filament")
-        return fields
-
-
-class SubtractiveOperation(Operation):
-    """An Operation of a machining process (mill, router, lathe)."""
-
-    process_data_class = SubtractiveProcessData
-
-    def _process_fields(self, k: int, columns: dict[str, np.ndarray]) -> dict[str, Any]:
-        fields = super()._process_fields(k, columns)
-        fields.update(spindle_speed=float(self.waypoints["spindle"][k]), removed_volume=None)
-        return fields
-
-
-OPERATION_CLASSES = {"additive": AdditiveOperation, "subtractive": SubtractiveOperation, "generic": Operation}

@@ -27,7 +27,7 @@ from ..emulate.presets import MachineConfig, load_machine
 from ..errors import ConfigError, Diagnostics, GcodeError, check_choice
 from ..limits import MAX_ITERATIONS, MAX_MOTIONS, Limits
 from ..memory import release_freed_memory
-from ..model.operation import OPERATION_CLASSES, Operation
+from ..model import OPERATION_CLASSES, Operation
 from ..parse import CommandTable, GcodeParser
 from ..plan import machine_options as firmware_options
 from ..plan import planner_settings, run_planner
