@@ -1,15 +1,11 @@
 """The notebooks in notebooks/: executed headless with nbclient, exported to HTML and
 opened offline in Chromium; the worksheets' exercises answered with values worked
-out by hand, which their check cells must accept.  Also ``gcodekit notebook`` and
-the package data it needs in a built wheel.
+out by hand, which their check cells must accept.  Also ``gcodekit notebook``
+(from a built wheel: tests/test_packaging.py).
 """
 
 import json
 import math
-import shutil
-import subprocess
-import sys
-import zipfile
 from pathlib import Path
 
 import pytest
@@ -130,26 +126,3 @@ def test_gcodekit_notebook_writes_a_runnable_notebook(tmp_path):
     assert (tmp_path / "bracket.html").stat().st_size > 50_000
     assert main(["notebook", str(ROOT / "examples" / "bracket_mill.ngc"), "-o", str(out)]) == 2  # kept
     assert main(["notebook", str(tmp_path / "missing.ngc"), "-o", str(tmp_path / "m.ipynb")]) == 2
-
-
-def test_widgets_work_from_a_built_wheel(tmp_path):
-    """The front ends are package data: a wheel holds them and the notebook command runs from it."""
-    wheels = tmp_path / "wheels"
-    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w",
-                    str(wheels), str(ROOT)], check=True, capture_output=True)
-    wheel = next(wheels.glob("gcodekit-*.whl"))
-    names = zipfile.ZipFile(wheel).namelist()
-    assert {"gcodekit/widgets/static/viewer.js", "gcodekit/widgets/static/velocity.js",
-            "gcodekit/widgets/notebook.py"} <= set(names)
-    site = tmp_path / "site"
-    zipfile.ZipFile(wheel).extractall(site)
-    program = tmp_path / "cube.gcode"
-    shutil.copy(ROOT / "examples" / "cube20_prusaslicer_marlin.gcode", program)
-    code = ("import sys, gcodekit; assert gcodekit.__file__.startswith(sys.argv[1]), gcodekit.__file__\n"
-            "from gcodekit.cli import main\n"
-            "from gcodekit.widgets.layer_viewer import ToolpathView\n"
-            "assert str(ToolpathView._esm).startswith('// gcodekit LayerViewer')\n"
-            "sys.exit(main(['notebook', sys.argv[2], '-o', sys.argv[3]]))")
-    subprocess.run([sys.executable, "-I", "-c", f"import sys; sys.path.insert(0, {str(site)!r})\n" + code,
-                    str(site), str(program), str(tmp_path / "cube.ipynb")], check=True, cwd=tmp_path)
-    assert "LayerViewer(op)" in (tmp_path / "cube.ipynb").read_text()

@@ -38,10 +38,10 @@ def fixed(value: float | None, digits: int = 1) -> str:
 
 @lru_cache(maxsize=1)
 def environment() -> "jinja2.Environment":
-    """The templates of :mod:`gcodekit.report` with autoescaping on for all of them."""
+    """The templates (``reports/``, shipped as :mod:`gcodekit.reports`) with autoescaping on for all of them."""
     import jinja2
 
-    env = jinja2.Environment(loader=jinja2.PackageLoader("gcodekit.report", "templates"), autoescape=True,
+    env = jinja2.Environment(loader=jinja2.PackageLoader("gcodekit.reports", ""), autoescape=True,
                              undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True)
     env.filters.update(duration=duration, fixed=fixed)
     return env

@@ -10,10 +10,11 @@ shows the widgets' pictures offline (:mod:`gcodekit.widgets.export`).
 from __future__ import annotations
 
 import os
+from importlib import resources
 from pathlib import Path
 
-#: The notebook template, kept with the project's other notebooks.
-TEMPLATE = Path(__file__).resolve().parents[2] / "reports" / "program_report.ipynb"
+#: The notebook template: ``reports/program_report.ipynb``, shipped as package data (:mod:`gcodekit.reports`).
+TEMPLATE = Path(str(resources.files("gcodekit.reports") / "program_report.ipynb"))
 #: Seconds one cell may run: emulating a large print takes seconds, not minutes.
 CELL_TIMEOUT_S = 600
 
@@ -35,7 +36,7 @@ def write_notebook(program: str | os.PathLike, out: str | os.PathLike, *, machin
     Raises
     ------
     FileNotFoundError
-        When the template is missing (gcodekit installed without its source tree).
+        When the template is missing.
     nbclient.exceptions.CellExecutionError
         When a cell fails; the message holds the cell's traceback.
     """

@@ -1,0 +1,95 @@
+"""What a user gets from ``pip install gcodekit[...]``: a built wheel, installed in a fresh virtual environment.
+
+The wheel must carry everything the commands read at run time (flavors,
+machine presets, report and notebook templates, widget scripts, the
+``py.typed`` marker), and ``gcodekit report --notebook`` and ``gcodekit
+notebook`` must run from it, not only from this checkout.  The fresh
+environment borrows the test environment's third-party libraries through a
+``.pth`` file (installing VTK and Jupyter again would need the network and
+minutes) but has its own gcodekit, installed from the wheel.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tomllib
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_package_folder_is_in_the_wheel_list():
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    folders = {".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "gcodekit").rglob("__init__.py")}
+    assert folders | {"gcodekit.reports"} == listed
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    """(python, gcodekit command) of a fresh virtual environment with the wheel installed."""
+    pytest.importorskip("nbclient")
+    tmp = tmp_path_factory.mktemp("wheel")
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w",
+                    str(tmp / "dist"), str(ROOT)], check=True, capture_output=True)
+    wheel = next((tmp / "dist").glob("gcodekit-*.whl"))
+    env = tmp / "venv"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(env)], check=True)
+    python = env / "bin" / "python"
+    site = Path(subprocess.run([str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                               check=True, capture_output=True, text=True).stdout.strip())
+    (site / "borrowed.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")  # numpy, pandas, VTK, Jupyter ...
+    subprocess.run([sys.executable, "-m", "pip", "--python", str(python), "install", "--no-deps", "-q", str(wheel)],
+                   check=True, capture_output=True)
+    return python, env / "bin" / "gcodekit", wheel
+
+
+def test_the_wheel_holds_the_data_files(installed):
+    _, _, wheel = installed
+    names = set(zipfile.ZipFile(wheel).namelist())
+    assert {"gcodekit/py.typed", "gcodekit/reports/program_report.ipynb", "gcodekit/reports/program.html",
+            "gcodekit/reports/style.css", "gcodekit/syntax/flavors/marlin.toml", "gcodekit/emulate/machines/linuxcnc.toml",
+            "gcodekit/widgets/static/viewer.js"} <= names
+    assert not any(n.startswith(("tests/", "notebooks/", "reports/")) for n in names)
+
+
+def test_the_installed_package_is_the_wheel_and_has_one_version(installed, tmp_path):
+    python, _, _ = installed
+    out = subprocess.run([str(python), "-I", "-c", "import gcodekit, importlib.metadata as m; "
+                          "print(gcodekit.__file__); print(gcodekit.__version__, m.version('gcodekit'))"],
+                         check=True, capture_output=True, text=True, cwd=tmp_path).stdout.split()
+    assert not out[0].startswith(str(ROOT / "gcodekit")) and out[1] == out[2]
+
+
+def test_report_with_notebook_runs_from_the_wheel(installed, tmp_path):
+    python, gcodekit, _ = installed
+    program = tmp_path / "cube.gcode"
+    shutil.copy(ROOT / "examples" / "cube20_prusaslicer_marlin.gcode", program)
+    env = {**os.environ, "PYTHONNOUSERSITE": "1", "VTK_DEFAULT_OPENGL_WINDOW": "vtkEGLRenderWindow",
+           "PATH": f"{gcodekit.parent}:{os.environ['PATH']}"}  # the notebook's kernel is this environment's python
+    done = subprocess.run([str(gcodekit), "report", str(program), "-o", str(tmp_path / "out"), "--notebook",
+                           "--no-pdf"], env=env, cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    notebook = json.loads((tmp_path / "out" / "cube.gcode.ipynb").read_text())
+    outputs = [o for c in notebook["cells"] if c["cell_type"] == "code" for o in c["outputs"]]
+    assert outputs and not [o for o in outputs if o["output_type"] == "error"]
+    # PrusaSlicer sliced this 20 mm cube in 100 layers of 0.2 mm; the page and the notebook say so
+    assert "Layers</th><td>100" in (tmp_path / "out" / "cube.gcode.html").read_text()
+    assert any("100" in "".join(o.get("data", {}).get("text/plain", "")) for o in outputs)
+
+
+def test_notebook_command_runs_from_the_wheel(installed, tmp_path):
+    python, gcodekit, _ = installed
+    program = tmp_path / "cube.gcode"
+    shutil.copy(ROOT / "examples" / "cube20_prusaslicer_marlin.gcode", program)
+    done = subprocess.run([str(gcodekit), "notebook", str(program), "-o", str(tmp_path / "cube.ipynb")],
+                          cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "LayerViewer(op)" in (tmp_path / "cube.ipynb").read_text()
