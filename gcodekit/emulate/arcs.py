@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..units import MM_PER_INCH
+
 #: (first, second, helix) axis indices and the I/J/K letters of each plane.
 PLANES = {
     17: ((0, 1, 2), ("I", "J")),
@@ -25,7 +27,7 @@ TWO_PI = 2.0 * np.pi
 def reach_tolerance(units: float) -> float:
     """How far (mm) an R-form arc may fall short of its end point before LinuxCNC refuses it
     (0.005 mm in G21, 0.0005 in in G20; ``units`` is mm per program unit)."""
-    return 0.005 if units == 1.0 else 0.0005 * 25.4
+    return 0.005 if units == 1.0 else 0.0005 * MM_PER_INCH
 
 
 def center_from_radius(start: np.ndarray, end: np.ndarray, radius: np.ndarray, clockwise: np.ndarray):

@@ -42,6 +42,8 @@ from __future__ import annotations
 import functools
 from typing import TYPE_CHECKING, Callable
 
+from ..units import MM_PER_INCH
+
 if TYPE_CHECKING:
     from .machine import Machine
     from .state import MachineState
@@ -60,7 +62,7 @@ def _position(axis: int) -> Callable[["MachineState"], float]:
 
 def _machine_unit(machine: "Machine", axis: int) -> float:
     """mm per machine unit on ``axis``: rs274 gives offsets in machine units (the tool table's), not the program's."""
-    return 25.4 if machine.config.tool_table_units == "inch" and axis < 3 else 1.0
+    return MM_PER_INCH if machine.config.tool_table_units == "inch" and axis < 3 else 1.0
 
 
 def _tool_offset(axis: int) -> Callable[["Machine"], float]:

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError
+from ..units import mm_per
 
 _WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
 #: A line rs274 2.9 reads: only these letters, each with a number (it skips one with ``WX0.05`` or ``K5``)
@@ -67,7 +68,7 @@ class ToolTable(dict):
         """Read a LinuxCNC tool table; ``units`` is ``"mm"`` or ``"inch"``."""
         if units not in ("mm", "inch"):
             raise ConfigError(f"tool table units must be 'mm' or 'inch', not {units!r}")
-        scale = 25.4 if units == "inch" else 1.0
+        scale = mm_per(units)
         table = cls()
         table.source = source
         for number, raw in enumerate(text.splitlines(), 1):

@@ -50,6 +50,7 @@ from ..emulate.lathe import profile_of, program_comment
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
 from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, NAME_ID, NAMES, PROFILE_TAG
+from ..units import MM_PER_INCH
 from .cycle_words import cycle_offset, diameter_words, lathe_defaults, length_words, level_words, rewrite_profile
 
 if TYPE_CHECKING:
@@ -113,7 +114,7 @@ class Transpiler:
             self.op.table.name != NAME_ID["coordinate_data"])
         flavor = self.op.flavor
         #: mm per output length unit from stage 1 on: the machine's own units
-        self.unit = 25.4 if flavor is not None and flavor.units == "inch" else 1.0
+        self.unit = MM_PER_INCH if flavor is not None and flavor.units == "inch" else 1.0
 
     # -- public -----------------------------------------------------------------
 
@@ -124,11 +125,11 @@ class Transpiler:
 
             raise ConfigError(f"stage must be one of 0-6, not {k!r}")
         frame = "absolute machine coordinates" if k >= 4 else "machine coordinates" if k >= 2 else "program coordinates"
-        unit_name = "inch" if self.unit == 25.4 else "mm"
+        unit_name = "inch" if self.unit == MM_PER_INCH else "mm"
         lines = [f"(gcodekit transpile stage {k}: machine units {unit_name}, {frame})" if k >= 1 else
                  "(gcodekit transpile stage 0: subprograms, loops and macros expanded)"]
         if k >= 1:  # the output says its units, so any controller reads it the same
-            lines.append("G20" if self.unit == 25.4 else "G21")
+            lines.append("G20" if self.unit == MM_PER_INCH else "G21")
         for row in range(len(self.op.table)):
             lines.extend(self._row(row, k))
         if not (self.op.table.name == NAME_ID["program_end"]).any():
@@ -214,7 +215,7 @@ class Transpiler:
 
     def _scale(self, row: int) -> float:
         """Output length units per program unit at ``row``."""
-        return (25.4 if self.op.waypoints["units"][self._waypoints(row)[-1]] == 1 else 1.0) / self.unit
+        return (MM_PER_INCH if self.op.waypoints["units"][self._waypoints(row)[-1]] == 1 else 1.0) / self.unit
 
     def _comment(self, row: int, cmd, k: int) -> str:
         """The command's comment as written out; a lathe cycle's profile takes the stage's units and offsets."""
@@ -303,7 +304,7 @@ class Transpiler:
         cmd = self.op.table.command(row)
         if self._incremental(row):
             return np.zeros(3)
-        scale = 25.4 if w["units"][points[-1]] == 1 else 1.0
+        scale = MM_PER_INCH if w["units"][points[-1]] == 1 else 1.0
         words = dict(cmd.params)
         if "X" in words and self._diameter_rows[row]:
             words["X"] /= 2.0  # G7: the X word is a diameter
