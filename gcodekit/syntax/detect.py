@@ -13,7 +13,7 @@ import os
 import re
 from dataclasses import dataclass
 
-from .flavor import Flavor
+from .flavor import DetectRules, Flavor
 from .loader import list_flavors, load_flavor
 
 #: Detection reads at most this much of the text it is given.
@@ -124,6 +124,56 @@ def _comment_style(lines: list[str]) -> str:
     return ";" if semi > paren else "(" if paren > semi else ""
 
 
+@dataclass(frozen=True)
+class _Evidence:
+    """What the head of a program shows, read once for every flavor's rules."""
+
+    head: str
+    bare: str  # the head without comments
+    codes: set[str]
+    style: str  # the comment style most lines use
+    suffix: str
+
+    @property
+    def e_words(self) -> bool:
+        return _E_WORD.search(self.bare) is not None
+
+
+def _score(rules: DetectRules, evidence: _Evidence) -> tuple[float, list[str]]:
+    """Points of one flavor's rules against the evidence, and why (see :func:`detect_flavor`)."""
+    score, reasons = 0.0, []
+    for pattern in rules.header:
+        if pattern.search(evidence.head):
+            score += HEADER_POINTS
+            reasons.append(f"header matches /{pattern.pattern}/")
+    for pattern in rules.against:
+        if pattern.search(evidence.head):
+            score -= AGAINST_POINTS
+            reasons.append(f"against: text matches /{pattern.pattern}/")
+    for pattern in rules.hints:
+        if pattern.search(evidence.bare):
+            score += HINT_POINTS
+            reasons.append(f"code matches /{pattern.pattern}/")
+    suffix = evidence.suffix
+    if suffix and suffix in rules.extensions:
+        score += EXTENSION_POINTS
+        reasons.append(f"file extension {suffix}")
+    elif suffix and suffix in rules.shared_extensions:
+        score += SHARED_EXTENSION_POINTS
+        reasons.append(f"file extension {suffix} (other dialects use it too)")
+    if evidence.e_words and rules.extrudes:
+        score += E_WORD_POINTS
+        reasons.append("E words on moves")
+    typical = sorted(rules.codes & evidence.codes)
+    if typical:
+        score += CODE_POINTS * len(typical)
+        reasons.append(f"typical codes {', '.join(typical)}")
+    if evidence.style and evidence.style == rules.comment:
+        score += COMMENT_POINTS
+        reasons.append(f"{evidence.style!r} comments")
+    return score, reasons
+
+
 def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None) -> Detection:
     """Guess the flavor of a program from its head and file name.
 
@@ -169,43 +219,12 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     """
     lines = text_head[:HEAD_CHARS].splitlines()[:HEAD_LINES]
     head = "\n".join(lines)
-    bare = _COMMENTS.sub("", head)
-    suffix = os.path.splitext(os.fspath(filename))[1].lower() if filename is not None else ""
-    present = _codes_in(head)
-    style = _comment_style(lines)
-    e_words = _E_WORD.search(bare) is not None
-
-    scored: list[tuple[float, int, str, list[str]]] = []
+    evidence = _Evidence(head, _COMMENTS.sub("", head), _codes_in(head), _comment_style(lines),
+                         os.path.splitext(os.fspath(filename))[1].lower() if filename is not None else "")
+    e_words, style = evidence.e_words, evidence.style
+    scored = []
     for rules in _all_rules():
-        score, reasons = 0.0, []
-        for pattern in rules.header:
-            if pattern.search(head):
-                score += HEADER_POINTS
-                reasons.append(f"header matches /{pattern.pattern}/")
-        for pattern in rules.against:
-            if pattern.search(head):
-                score -= AGAINST_POINTS
-                reasons.append(f"against: text matches /{pattern.pattern}/")
-        for pattern in rules.hints:
-            if pattern.search(bare):
-                score += HINT_POINTS
-                reasons.append(f"code matches /{pattern.pattern}/")
-        if suffix and suffix in rules.extensions:
-            score += EXTENSION_POINTS
-            reasons.append(f"file extension {suffix}")
-        elif suffix and suffix in rules.shared_extensions:
-            score += SHARED_EXTENSION_POINTS
-            reasons.append(f"file extension {suffix} (other dialects use it too)")
-        if e_words and rules.extrudes:
-            score += E_WORD_POINTS
-            reasons.append("E words on moves")
-        typical = sorted(rules.codes & present)
-        if typical:
-            score += CODE_POINTS * len(typical)
-            reasons.append(f"typical codes {', '.join(typical)}")
-        if style and style == rules.comment:
-            score += COMMENT_POINTS
-            reasons.append(f"{style!r} comments")
+        score, reasons = _score(rules, evidence)
         scored.append((score, rules.priority, rules.name, reasons))
 
     scored.sort(key=lambda s: (-s[0], -s[1], s[2]))
