@@ -51,6 +51,8 @@ _ARC_GOUGE = "Arc move in concave corner cannot be reached by the tool without g
 
 
 class State(enum.Enum):
+    """Where the pass is between G41/G42 and G40 (see the module's table)."""
+
     OFF = "off"
     ENTRY = "entry"
     ON = "on"
@@ -122,6 +124,8 @@ class Compensator:
     # -- commands without waypoints: the transitions off/exit -> entry and entry/on -> exit
 
     def _read_command(self, r: int, step: Step) -> None:
+        """Command ``r``, read before ``step``: a compensation code, which changes the state (G41/G42 while
+        on, or G40 while off, leaves it as it is), or a tool change."""
         if r in self.side_rows:
             side = self.side_rows[r]
             if side and self.state in (State.OFF, State.EXIT):
@@ -164,9 +168,10 @@ class Compensator:
     # -- waypoints
 
     def _step(self, step: Step) -> None:
+        """One waypoint: written as it is, where the tool is, or by the state's handler of a move."""
         if self.held:
             self._held_step(step)
-        elif self.state is State.OFF or self.radius <= 0:
+        elif self.state is State.OFF or self.radius <= 0:  # nothing to offset (the states still follow)
             self.out.emit(step.k)
         elif step.motion == MOTION_NONE:  # a command without motion stays where the tool is
             self.out.emit(step.k, **({step.a: self.out.last(step.a), step.b: self.out.last(step.b)}
@@ -191,6 +196,7 @@ class Compensator:
         self._off()
 
     def _off(self) -> None:
+        """-> off: no move before, nothing queued."""
         self.state = State.OFF
         self.last_dir, self.last_corner, self.last_path = None, None, None
         self.queue.clear()
