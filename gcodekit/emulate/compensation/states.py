@@ -204,36 +204,40 @@ class Compensator:
     def _entry_move(self, step: Step) -> None:
         """entry -> on: to the programmed end shifted by the radius, straight or on an arc."""
         tool_at, end = self._tool_at(step), self._end(step)
-        if self.entry_row != step.row and step.motion < MOTION_CW and np.hypot(*(end - tool_at)) < self.radius - TINY \
-                and not self._leaves_plane(step):
-            self.entry_row = step.row
-            self._error(step.row, "Length of cutter compensation entry move is not greater than the tool radius")
+        self._check_entry_length(step, tool_at, end)
         move = self._offset(step, tool_at, end)
         if move is None:
             return
         self.out.shift = self.lathe
+        at = {step.a: move.new_end[0], step.b: move.new_end[1]}
         if move.arc is None:  # comp1: straight to the end shifted off the entry move's own direction
-            self.queue.hold(self.out.emit(step.k, **{step.a: move.new_end[0], step.b: move.new_end[1]}), tool_at,
-                            direction=move.in_dir)
             path = move.path
+            self.queue.hold(self.out.emit(step.k, **at), tool_at, direction=move.in_dir)
         else:  # comp1 arc: on a centre moved along the end radius, so it leaves on the programmed tangent
             path = entry_arc(tool_at, move)
             if self.lathe != (0.0, 0.0):
                 self._feed_onto_nose(step, tool_at)
-            self.queue.hold(self.out.emit(step.k, **{step.a: move.new_end[0], step.b: move.new_end[1],
-                                                     "c" + step.a: path.centre[0], "c" + step.b: path.centre[1]}),
-                            tool_at)
+            at.update({"c" + step.a: path.centre[0], "c" + step.b: path.centre[1]})
+            self.queue.hold(self.out.emit(step.k, **at), tool_at)
         self.state = State.ON
         self.last_dir, self.last_corner, self.last_path = move.out_dir, move.end, path
+
+    def _check_entry_length(self, step: Step, tool_at: np.ndarray, end: np.ndarray) -> None:
+        """rs274 refuses a straight entry in the plane not longer than the radius (once per command)."""
+        if self.entry_row != step.row and step.motion < MOTION_CW and np.hypot(*(end - tool_at)) < self.radius - TINY \
+                and not self._leaves_plane(step):
+            self.entry_row = step.row
+            self._error(step.row, "Length of cutter compensation entry move is not greater than the tool radius")
 
     def _feed_onto_nose(self, step: Step, tool_at: np.ndarray) -> None:
         """Before a lathe tool's entry arc, rs274 feeds its control point onto the shifted start, or the
         entry would not be an arc (``convert_arc_comp1``)."""
         length = float(np.hypot(*self.lathe))
         feed = float(self.columns["feed"][step.k])
-        self.out.emit(step.k, **{step.a: tool_at[0], step.b: tool_at[1], step.h: self.out.last(step.h) if self.out
-                                 else 0.0}, motion=MOTION_LINEAR, cx=np.nan, cy=np.nan, cz=np.nan, distance=length,
-                      de=0.0, time=length / (feed / 60.0) if feed > 0 else 0.0)
+        height = self.out.last(step.h) if self.out else 0.0
+        self.out.emit(step.k, **{step.a: tool_at[0], step.b: tool_at[1], step.h: height}, motion=MOTION_LINEAR,
+                      cx=np.nan, cy=np.nan, cz=np.nan, distance=length, de=0.0,
+                      time=length / (feed / 60.0) if feed > 0 else 0.0)
 
     def _on_move(self, step: Step) -> None:
         """on: the move offset, joined to the one before by an outside or inside corner."""
