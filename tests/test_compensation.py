@@ -162,3 +162,25 @@ def test_tool_orientation_from_table_and_g10(lathe_tools):
     # G10 L1 Q gives T3 orientation 2: its path is then the Q2 one
     m = motions(LATHE_PROGRAM.format(tool=3).replace("M6\n", "M6\nG10 L1 P3 Q2\n", 1), lathe_tools)
     np.testing.assert_allclose(m[["x", "z"]].to_numpy()[1:3], [[5, 3], [5, -11]], atol=1e-12)
+
+
+def test_states_follow_the_codes_and_the_moves(tool_table, monkeypatch):
+    # The pass's states (rs274's cutter_comp_side and cutter_comp_firstmove), as the program
+    # says: G42 arms the entry, a plunge is no entry, the first move in the plane is; G40 arms
+    # the exit, which a spindle start does not take, the next move does.
+    from gcodekit.emulate import compensation
+
+    after: dict[int, str] = {}  # source line -> state after its last waypoint
+
+    class Recording(compensation.Compensator):
+        def _step(self, step):
+            super()._step(step)
+            after[int(self.table.line[step.row])] = self.state.value
+
+    monkeypatch.setattr(compensation, "Compensator", Recording)
+    text = "G21 G17 G90 T1 M6\nG0 X-5 Y0\nG42\nG0 Z1\nG1 X0 Y0 F600\nX10\nG40\nM3 S100\nG0 X20\n"
+    m = motions(text, tool_table)
+    assert after == {1: "off", 2: "off", 3: "entry", 4: "entry", 5: "on", 6: "on", 7: "exit", 8: "exit", 9: "off"}
+    # the plunge keeps the tool where it was; the entry ends 1 mm right of the +X move
+    np.testing.assert_allclose(m[["x", "y", "z"]].to_numpy()[1:5], [[-5, 0, 1], [0, -1, 1], [10, -1, 1],
+                                                                     [20, 0, 1]], atol=1e-12)
