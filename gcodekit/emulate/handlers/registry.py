@@ -36,8 +36,10 @@ from ..tooltable import ToolTable
 if TYPE_CHECKING:
     from ..presets import MachineConfig
 
-# Mode keys: blocks the dispatcher routes by the motion mode they move in (see modal.route)
-#: G70-G72 (LinuxCNC's lathe cycles), named or not
+# Mode keys: for blocks the dispatcher routes by more than their name (see modal.route): axis
+# words alone in a mode, a T word, and the blocks the machine picks to run one at a time by their
+# motion mode (canned cycles, G33/G33.1, G70-G72), whose names have no handler of their own.
+#: a G70-G72 block (LinuxCNC's lathe cycles)
 LATHE_CYCLE = "(lathe cycle)"
 #: axis words alone after a lathe cycle: a move in the mode of the cycle's last move
 AFTER_LATHE_CYCLE = "(after a lathe cycle)"
@@ -176,11 +178,11 @@ def handles(*keys: str) -> Callable[[Handler], Handler]:
     each has one handler.
     """
     def register(handler: Handler) -> Handler:
-        for key in keys:
+        for key in keys:  # all checked before any is registered
             if key not in NAME_ID and key not in MODE_KEYS:
                 raise ValueError(f"{key!r} is neither a command name nor a mode key")
             if key in HANDLERS:
                 raise ValueError(f"{key!r} already has a handler: {HANDLERS[key].__qualname__}")
-            HANDLERS[key] = handler
+        HANDLERS.update(dict.fromkeys(keys, handler))
         return handler
     return register
