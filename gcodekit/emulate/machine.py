@@ -5,7 +5,8 @@ offsets, plane).  Runs of such commands are emulated with array code: in
 absolute mode a target coordinate is the last one given (a forward fill),
 in incremental mode it is a running sum.  Commands that change that state
 (G20/G21, G90/G91, G92, G54..., G28, G53, M82/M83, tool changes, ...) are
-few and are handled one at a time in :mod:`.modal`, between the runs.
+few and are handled one at a time between the runs, each by the handler
+registered for it (:mod:`.modal` dispatches, :mod:`.handlers` holds them).
 
 Every command gives one waypoint: its end state.  A command that moves
 through several points (G28 via its intermediate point) adds waypoints
@@ -26,6 +27,7 @@ from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, M
                            SPLINE_MOTIONS, CommandTable)
 from ..schema import allocate
 from . import arcs
+from .handlers import Context
 from .ini import LinuxCncIni
 from .modal import ModalHandler, Waypoint
 from .presets import MachineConfig
@@ -101,7 +103,6 @@ class Machine:
         for number, text, reason in self.tools.skipped[:20]:
             self.diagnostics.report(number, 1, f"tool table line skipped, as LinuxCNC does: {reason}", text,
                                     severity="warning", file=self.tools.source)
-        self.modal = ModalHandler(self)
         self._straight_ids = np.array([NAME_ID["rapid"], NAME_ID["linear"]], np.uint8)
         self._motion_mode_ids = np.array(sorted(NAME_ID[n] for n in MOTIONS | {"rigid_tap"}), np.uint8)
         self._table_z, self._table_w = np.nan, 0.0  # last Z and table-axis words (see _part_frame)
@@ -113,6 +114,11 @@ class Machine:
         #: (source line, profile end X Y Z in machine coordinates) of each G70 run under cutter
         #: compensation, in order: the compensation pass needs it (see ``compensation``)
         self.comp_profile_ends: list[tuple[int, np.ndarray]] = []
+        # the state-changing commands see the machine's parts, not the machine
+        self.modal = ModalHandler(Context(self.state, config, self.diagnostics, self.tools, self.budget,
+                                          self.warn_once, rs274_blocks=rs274_blocks,
+                                          polar_incremental_only=polar_incremental_only,
+                                          rapid_is_feed=self.rapid_is_feed, comp_profile_ends=self.comp_profile_ends))
 
     # -- running ----------------------------------------------------------------
 
@@ -205,7 +211,7 @@ class Machine:
         if stop < n and not self.out_of_budget:
             self._out_of_budget(int(table.line[stop]), f"the program makes more than max_motions="
                                 f"{self.budget.limit:,} motions")
-        self.modal.cycle_mode_open = bool(n) and int(table.motion[-1]) == MOTION_CYCLE
+        self.modal.context.cycle_mode.open = bool(n) and int(table.motion[-1]) == MOTION_CYCLE
         setting = np.flatnonzero((table.letter == ord("G")) & np.isin(table.name, self._motion_mode_ids))
         if setting.size:  # the motion mode in force (#<_motion_mode>)
             self.state.motion_code = int(table.number[setting[-1]])
@@ -270,7 +276,7 @@ class Machine:
 
     def _hold(self, start: int, stop: int, out: dict) -> None:
         """Rows after the program end: nothing moves."""
-        self.fill_state(slice(start, stop), out)
+        self.state.fill_columns(slice(start, stop), out)
         for k, v in zip(AXES.lower(), self.state.position):
             out[k][start:stop] = v
         for k in ("de", "distance", "time"):
@@ -280,18 +286,6 @@ class Machine:
         out["motion"][start:stop] = 0
         out["spindle"][start:stop] = self.state.speed * self.state.spindle
         out["feed"][start:stop] = self.state.feed
-
-    def fill_state(self, rows: slice | int, out: dict) -> None:
-        """The modal state columns of waypoint ``rows`` (plane, units, tool, ...)."""
-        s = self.state
-        out["plane"][rows] = s.plane
-        out["units"][rows] = 1 if s.units != 1.0 else 0
-        out["tool"][rows] = s.tool
-        out["coolant"][rows] = s.coolant
-        out["laser"][rows] = s.laser
-        out["work_offset"][rows] = s.work_offset
-        out["flow"][rows] = s.flow
-        out["rotation"][rows] = s.rotation
 
     # -- runs of plain commands ---------------------------------------------------
 
@@ -371,7 +365,7 @@ class Machine:
         out["motion"][rows] = motion
         out["cx"][rows], out["cy"][rows], out["cz"][rows] = centers.T
         out["spindle"][rows] = speed * s.spindle
-        self.fill_state(rows, out)
+        self.state.fill_columns(rows, out)
 
         s.position = position[-1].copy()
         if moving.any():

@@ -141,3 +141,14 @@ class MachineState:
     def scale(self) -> np.ndarray:
         """Program units to mm per axis (rotary axes stay in degrees)."""
         return np.where(LINEAR, self.units, 1.0)
+
+    def fill_columns(self, rows: slice | int, out: dict) -> None:
+        """Write the modal state into the waypoint columns ``out`` at ``rows`` (plane, units, tool, ...)."""
+        out["plane"][rows] = self.plane
+        out["units"][rows] = 1 if self.units != 1.0 else 0
+        out["tool"][rows] = self.tool
+        out["coolant"][rows] = self.coolant
+        out["laser"][rows] = self.laser
+        out["work_offset"][rows] = self.work_offset
+        out["flow"][rows] = self.flow
+        out["rotation"][rows] = self.rotation

@@ -1,7 +1,7 @@
 """Emulate stage: work coordinate systems and the G92/G52 offset, as LinuxCNC keeps them.
 
 A program point reaches the machine as ``rotate(program + G92, R) + G5x +
-tool`` (see :class:`~.state.MachineState`).  Each work system G54..G59.3
+tool`` (see :class:`~gcodekit.emulate.state.MachineState`).  Each work system G54..G59.3
 has stored offsets and an XY rotation R (LinuxCNC's #5221-#5390); the one
 selected brings its stored values into force.  The G92 offset (G52 writes
 it too) is kept in force and stored (#5211..), so G92.2 can suspend it and
@@ -13,12 +13,17 @@ that point as the program position (``keep_program_position``), so the
 machine only moves on the next move, wherever rs274's arithmetic differs
 from the machine's true position (a rotation change with a G92 offset on).
 
-All values are mm (degrees for rotations and rotary axes), by axis index.
+The frame arithmetic takes the state and values in mm (degrees for
+rotations and rotary axes) by axis index; the handlers at the end read the
+blocks (G54-G59.3, G92 family, G52, G10).
 """
 
 from __future__ import annotations
 
-from .state import MachineState, rotate_xy
+from ..state import MachineState, rotate_xy
+from .registry import Block, Context, handles
+from .tools import set_tool_data
+from .words import axis_values
 
 
 def select(s: MachineState, index: int) -> None:
@@ -106,3 +111,70 @@ def suspend_axis_offset(s: MachineState) -> None:
 def restore_axis_offset(s: MachineState) -> None:
     """G92.3: the stored G92 offset (perhaps written as #5211..) comes into force."""
     s.g92, s.g92_on = s.g92_stored.copy(), True
+
+
+# -- the blocks ----------------------------------------------------------------------
+
+
+@handles(*(f"work_offset_{k}" for k in range(1, 10)))
+def select_work_system(ctx: Context, block: Block) -> None:
+    """G54..G59.3."""
+    select(ctx.state, int(block.name.rsplit("_", 1)[1]))
+
+
+@handles("set_position")
+def set_position(ctx: Context, block: Block) -> None:
+    """G92: offset the axes so the current point has the given coordinates (and E, on printers)."""
+    s, params = ctx.state, block.params
+    values = axis_values(s, params)
+    if not values and "E" not in params and ctx.config.home_mode == "stored":
+        ctx.error(block.line, "G92 needs at least one axis word")
+    set_axis_offset(s, values)
+    if "E" in params:
+        s.e_program = params["E"] * s.units
+
+
+@handles("clear_position_offset")
+def clear_position_offset(ctx: Context, block: Block) -> None:
+    """G92.1."""
+    clear_axis_offset(ctx.state)
+
+
+@handles("suspend_position_offset")
+def suspend_position_offset(ctx: Context, block: Block) -> None:
+    """G92.2."""
+    suspend_axis_offset(ctx.state)
+
+
+@handles("restore_position_offset")
+def restore_position_offset(ctx: Context, block: Block) -> None:
+    """G92.3."""
+    restore_axis_offset(ctx.state)
+
+
+@handles("local_offset")
+def local_offset(ctx: Context, block: Block) -> None:
+    """G52."""
+    set_local_offset(ctx.state, axis_values(ctx.state, block.params))
+
+
+@handles("coordinate_data")
+def coordinate_data(ctx: Context, block: Block) -> None:
+    """G10: L2/L20 set a work offset, L1/L10/L11 a tool's offsets (LinuxCNC 2.9)."""
+    s, params, line = ctx.state, block.params, block.line
+    mode = int(params.get("L", -1))
+    if mode in (1, 10, 11):
+        set_tool_data(ctx, mode, params)
+        return
+    if mode not in (2, 20):
+        ctx.error(line, "G10 needs L1, L2, L10, L11 or L20")
+        return
+    index = int(params.get("P", 0)) or s.work_offset
+    if not 1 <= index <= 9:
+        ctx.error(line, f"G10 L{mode} P must be 0 to 9")
+    elif mode == 20 and "R" in params:
+        ctx.error(line, "R not allowed in G10 L20")
+    elif mode == 2:
+        set_offsets(s, index, axis_values(s, params), params.get("R"))
+    else:
+        touch_off(s, index, axis_values(s, params))
