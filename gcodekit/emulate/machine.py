@@ -26,6 +26,7 @@ from ..parse.split import MOTIONS
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, MOTION_THREAD, NAME_ID,
                            SPLINE_MOTIONS, CommandTable)
 from ..schema import allocate
+from ..units import MM_PER_INCH, mm_per
 from . import arcs
 from .handlers import Context
 from .ini import LinuxCncIni
@@ -90,7 +91,7 @@ class Machine:
         self.rs274_blocks = rs274_blocks
         self.polar_incremental_only = polar_incremental_only  # GER's G16 rules
         self.state = MachineState()
-        self.state.units = 25.4 if initial_units == "inch" else 1.0
+        self.state.units = mm_per(initial_units)
         self.state.e_relative = initial_extrusion == "relative"
         self.state.cycle.retract_to_r = config.cycle_retract == "r"
         if config.initial_feed > 0:
@@ -476,7 +477,7 @@ class Machine:
         # LinuxCNC 2.9 rejects centre-format arcs whose end radius differs from the start
         # radius by more than its spiral tolerance (2*sqrt(2)*0.01 mm, or 0.001 in in G20)
         # and 0.1 % of the larger radius, or by 100 times that tolerance (interp_arc.cc)
-        tolerance = 2 * np.sqrt(2) * (0.001 * 25.4 if units != 1.0 else 0.01)
+        tolerance = 2 * np.sqrt(2) * (0.001 * MM_PER_INCH if units != 1.0 else 0.01)
         error = np.abs(r1 - r0)
         bad = (error > 100 * tolerance) | ((error > tolerance) & (error > 0.001 * np.maximum(r0, r1)))
         for i in np.flatnonzero(bad)[:20]:

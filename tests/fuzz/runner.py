@@ -23,6 +23,7 @@ The last four are failures.
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import re
@@ -59,8 +60,8 @@ class Outcome:
 def run_cases(cases: list[Case], *, timeout: float = 60.0, memory_mb: float = 2048.0, jobs: int = 1,
               keep: Path | None = None) -> list[Outcome]:
     """Run every case; ``keep`` saves the folders of failing cases for a rerun."""
-    import gcodekit.cli  # noqa: F401 -- imported once, shared by every child
-    import gcodekit.pipeline  # noqa: F401
+    for module in ("gcodekit.cli", "gcodekit.pipeline"):  # imported once, shared by every child
+        importlib.import_module(module)
 
     outcomes: list[Outcome] = []
     waiting = list(reversed(cases))
