@@ -21,7 +21,7 @@ from ..parse.calls import call_bead_area
 from ..parse.commands import Kind
 from .arcs import PLANES, centres, reach_tolerance, single_turn_lengths
 from .cycles import CYCLES, TAPPING, polar_target, run_cycle
-from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
+from .lathe import LATHE_CYCLES, CycleBlock, LatheCycleError, Move, run_lathe_cycle
 from .threading import ThreadingError, check_words, threading_moves
 from .splines import SPLINE_NAMES, SplineBlocks
 from .state import AXES, MachineState, rotate_xy
@@ -29,6 +29,7 @@ from .tooltable import Tool
 from . import work_systems
 
 if TYPE_CHECKING:
+    from ..lathe_profile import LatheProfile
     from .machine import Machine
 
 SPECIAL_NAMES = frozenset(
@@ -120,7 +121,7 @@ class ModalHandler:
         repeat = moves and int(t.motion[row]) == MOTION_CYCLE and not name
         if name in LATHE_CYCLES:
             self._cycle_name = name
-            motion, extra = self._lathe_cycle(name, params, t.command(row).comment, line)
+            motion, extra = self._lathe_cycle(name, params, t.profiles.get(row), line)
             self._lathe_motion = motion
         elif repeat and self._cycle_name in LATHE_CYCLES:
             motion = self._after_lathe_cycle(params, line)
@@ -378,11 +379,12 @@ class ModalHandler:
         centre[h] = np.nan
         return tuple(centre)
 
-    def _lathe_cycle(self, name: str, params: dict, comment: str | None, line: int) -> tuple[int, list[Waypoint]]:
+    def _lathe_cycle(self, name: str, params: dict, profile: LatheProfile | None,
+                     line: int) -> tuple[int, list[Waypoint]]:
         """G70-G72: the moves of a lathe cycle become waypoints (see :mod:`.lathe`)."""
         s = self.state
         program = s.program_position()
-        block = CycleBlock(name, params, profile_of(comment), complex(program[2], program[0]), s.units,
+        block = CycleBlock(name, params, profile, complex(program[2], program[0]), s.units,
                            s.incremental, s.arc_incremental, s.diameter, s.plane, s.compensating)
         try:
             point, moves, profile_end = run_lathe_cycle(block, self.machine.budget)

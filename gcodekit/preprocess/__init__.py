@@ -2,7 +2,7 @@
 
 Preprocessing rewrites a program's lines before they are read into words:
 parameters and expressions (:mod:`.parameters`, :mod:`.expressions`), O-word
-control flow and subprograms (:mod:`.flow`); wizards later.
+control flow and subprograms (:mod:`.flow`) and GER wizards (:mod:`.wizards`).
 Each step is a :class:`Stage` that maps a stream of :class:`SourceLine` to
 another, keeping every line's source file and 1-based line number so later
 diagnostics still point at what the user wrote.  :func:`run_stages` chains
@@ -12,10 +12,11 @@ stages lazily, so a large file streams through with bounded memory.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Iterable, Iterator, Protocol, runtime_checkable
 
 from gcodekit.errors import Diagnostics, GcodeError
+from gcodekit.lathe_profile import LatheProfile
 from gcodekit.preprocess.expressions import evaluate as _evaluate
 from gcodekit.preprocess.expressions import parse
 from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, needs_parameters
@@ -33,11 +34,15 @@ class SourceLine:
     line : int
         1-based line number in ``file``.
     file : str
+    profile : LatheProfile or None
+        On a lathe cycle (G70-G72) that ran: the profile its ``Q``
+        subroutine gave (see :mod:`gcodekit.lathe_profile`).
     """
 
     text: str
     line: int
     file: str
+    profile: LatheProfile | None = field(default=None, repr=False)
 
 
 @runtime_checkable

@@ -3,8 +3,8 @@
 rs274 reads the subroutine when G70-G72 runs, without moving: its control
 flow and parameters run as in a call, ``#<_x>`` and ``#<_z>`` give the
 profile's point so far (the cycle's X/Z at first).  The blocks it reads are
-attached to the cycle line, so later stages run the cycle without the
-subroutine.
+attached to the cycle line as a :class:`~gcodekit.lathe_profile.LatheProfile`,
+so later stages run the cycle without the subroutine.
 """
 
 from __future__ import annotations
@@ -12,9 +12,10 @@ from __future__ import annotations
 import contextlib
 import math
 import re
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from gcodekit.parse.table import PROFILE_TAG
+from gcodekit.lathe_profile import LatheProfile, ProfileBlock
 from gcodekit.preprocess.expressions import compact
 from gcodekit.preprocess.flow.mcodes import WORD
 from gcodekit.preprocess.flow.statements import OWord
@@ -30,7 +31,7 @@ _LATHE_CYCLES = frozenset((70.0, 71.0, 71.1, 71.2, 72.0, 72.1, 72.2))
 
 
 def with_profile(run: Run, line: SourceLine) -> SourceLine:
-    """A lathe cycle (G70-G72) with the blocks of its Q subroutine attached as a comment.
+    """A lathe cycle (G70-G72) with the profile its Q subroutine gives attached.
 
     Any other line, or a cycle whose subroutine is not found (reported), is
     returned as it is.
@@ -68,9 +69,9 @@ def with_profile(run: Run, line: SourceLine) -> SourceLine:
                 elif letter in code:
                     point[key] += code[letter]
             code_text = " ".join(text[a:b] for a, b in run.code_ranges(text)).strip()
-            if code_text:
-                blocks.append(code_text.replace(";", " ").replace("(", " ").replace(")", " "))
-    return line.__class__(f"{line.text} ({PROFILE_TAG} {'; '.join(blocks)})", line.line, line.file)
+            if code_text:  # without the written form's separator and comment marks
+                blocks.append(ProfileBlock.read(code_text.replace(";", " ").replace("(", " ").replace(")", " ")))
+    return replace(line, profile=LatheProfile(tuple(blocks)))
 
 
 def _code_words(run: Run, text: str) -> list[tuple[str, float]]:
