@@ -12,50 +12,14 @@ stages lazily, so a large file streams through with bounded memory.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
-from typing import Iterable, Iterator, Protocol, runtime_checkable
+from typing import Iterable, Iterator
 
 from gcodekit.errors import Diagnostics, GcodeError
-from gcodekit.lathe_profile import LatheProfile
 from gcodekit.preprocess.expressions import evaluate as _evaluate
 from gcodekit.preprocess.expressions import parse
-from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, needs_parameters
 from gcodekit.preprocess.flow import ControlFlowStage
-
-
-@dataclass(frozen=True, slots=True)
-class SourceLine:
-    """One line of program text and where it came from.
-
-    Attributes
-    ----------
-    text : str
-        The line without its line ending.
-    line : int
-        1-based line number in ``file``.
-    file : str
-    profile : LatheProfile or None
-        On a lathe cycle (G70-G72) that ran: the profile its ``Q``
-        subroutine gave (see :mod:`gcodekit.lathe_profile`).
-    """
-
-    text: str
-    line: int
-    file: str
-    profile: LatheProfile | None = field(default=None, repr=False)
-
-
-@runtime_checkable
-class Stage(Protocol):
-    """A preprocess step: a named map from lines to lines.
-
-    ``process`` reports problems to ``diagnostics`` (which raises in strict
-    mode) and, in lenient mode, goes on with the next line.
-    """
-
-    name: str
-
-    def process(self, lines: Iterable[SourceLine], diagnostics: Diagnostics) -> Iterator[SourceLine]: ...
+from gcodekit.preprocess.lines import SourceLine, Stage
+from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, needs_parameters
 
 
 def run_stages(

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from gcodekit.preprocess.parameters import format_number
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess import SourceLine
+    from gcodekit.preprocess.lines import SourceLine
     from gcodekit.preprocess.flow.run import Run
 
 

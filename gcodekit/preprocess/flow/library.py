@@ -12,14 +12,12 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable
+from typing import Callable
 
 from gcodekit.errors import did_you_mean
 from gcodekit.preprocess.flow.linking import Table, link
 from gcodekit.preprocess.flow.statements import Code, OWord, Report, where
-
-if TYPE_CHECKING:
-    from gcodekit.preprocess import SourceLine
+from gcodekit.preprocess.lines import SourceLine
 
 # LinuxCNC subroutine file names: lower-case letters, digits, '-' and '_'.
 _FILE_NAME = re.compile(r"[a-z0-9_-]+")
@@ -117,8 +115,6 @@ class Library:
         return None
 
     def _load(self, path: Path) -> None:
-        from gcodekit.preprocess import SourceLine
-
         self.loaded.add(str(path))
         text = path.read_text("utf-8", errors="replace")
         lines = text.split("\n")

@@ -22,7 +22,7 @@ from gcodekit.preprocess.flow.statements import OWord
 from gcodekit.preprocess.parameters import format_number
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess import SourceLine
+    from gcodekit.preprocess.lines import SourceLine
     from gcodekit.preprocess.flow.run import Run
 
 # Cheap test for a line that may hold a lathe cycle G70-G72

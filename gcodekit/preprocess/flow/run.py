@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Iterator
 
 from gcodekit.errors import Diagnostics, GcodeError, GcodeLimitError
 from gcodekit.preprocess.expressions import Node, evaluate
-from gcodekit.preprocess.flow import fanuc
+from gcodekit.preprocess.flow.fanuc import m98, m99
 from gcodekit.preprocess.flow.library import Library
 from gcodekit.preprocess.flow.mcodes import flow_m, remove
 from gcodekit.preprocess.flow.profile import with_profile
@@ -27,7 +27,7 @@ from gcodekit.preprocess.flow.statements import Code, OWord, read_statement, whe
 from gcodekit.preprocess.parameters import format_number
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess import SourceLine
+    from gcodekit.preprocess.lines import SourceLine
     from gcodekit.preprocess.flow.stage import ControlFlowStage
 
 
@@ -328,8 +328,8 @@ class Run:
         if rest.strip(" \t" + self.separators):
             yield replace(line, text=rest)
         if flow.code == 98:
-            fanuc.m98(self, line, flow.p, flow.count)
-        elif fanuc.m99(self, line):
+            m98(self, line, flow.p, flow.count)
+        elif m99(self, line):
             raise Stop
 
     def substitute(self, st: SourceLine) -> SourceLine:

@@ -12,7 +12,7 @@ from gcodekit.preprocess.flow.run import Run
 from gcodekit.preprocess.parameters import ParameterStage, ParameterStore
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess import SourceLine
+    from gcodekit.preprocess.lines import SourceLine
     from gcodekit.syntax.flavor import Flavor
 
 #: Deepest nesting of subroutine calls.  LinuxCNC has

@@ -16,7 +16,7 @@ from gcodekit.errors import GcodeError, GcodeLimitError, did_you_mean
 from gcodekit.preprocess.expressions import CompactText, Node, compact, expression_error, parse_value
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess import SourceLine
+    from gcodekit.preprocess.lines import SourceLine
 
 # Longest first, so 'elseif' is not read as 'else'.
 KEYWORDS = ("endrepeat", "continue", "endwhile", "elseif", "endsub", "repeat", "return",

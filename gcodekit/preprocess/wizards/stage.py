@@ -16,13 +16,13 @@ from gcodekit.errors import (
     did_you_mean,
 )
 from gcodekit.limits import MAX_MOTIONS
+from gcodekit.preprocess.lines import SourceLine
 from gcodekit.preprocess.wizards.arguments import Argument, BadCall, bind, read_arguments
 from gcodekit.preprocess.wizards.context import MAX_LINES, WizardArgumentError, WizardContext, WizardFunction
 from gcodekit.preprocess.wizards.registry import DEFAULT_REGISTRY, NAME, WizardRegistry
 from gcodekit.units import MM_PER_INCH
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess import SourceLine
     from gcodekit.syntax.flavor import Flavor
 
 _LOOKS_LIKE_CALL = re.compile(r"(?m)^[ \t]*[A-Za-z]{2}")
@@ -107,8 +107,6 @@ class _Run:
 
     def run(self, lines: Iterable[SourceLine]) -> Iterator[SourceLine]:
         """Yield ``lines`` with every wizard call replaced by what it emits."""
-        from gcodekit.preprocess import SourceLine
-
         for sl in lines:
             start = self._call_start(sl.text)
             if start < 0:
