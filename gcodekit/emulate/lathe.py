@@ -5,7 +5,8 @@ Behaviour mirrored: LinuxCNC 2.9 ``interp_g7x.cc`` (Debian 12 package
 
 Points are complex numbers ``z + x*1j`` in program coordinates (X a
 radius).  The profile is the chain of G0/G1/G2/G3 blocks of the ``Q``
-subroutine, starting at the cycle point (the block's X/Z).  The cycle
+subroutine (a :class:`~gcodekit.lathe_profile.LatheProfile`, read by the
+preprocess stage), starting at the cycle point (the block's X/Z).  The cycle
 mirrors and rotates the profile so that it always descends in X and Z
 (``_Profile.normalise``), works there, and maps every move back.
 

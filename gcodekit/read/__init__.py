@@ -188,8 +188,9 @@ def iter_source_blocks(lines: Iterable, flavor: Flavor, diagnostics: Diagnostics
         else:
             found = tokenizer.tokenize(sl.text, sl.line)
             profile = getattr(sl, "profile", None)  # lines may be any objects with text and line
-            for block in found if profile is not None else ():
-                block.profile = profile
+            if profile is not None:
+                for block in found:
+                    block.profile = profile
             raw.extend(found)
         count += 1
         if chunk_lines is not None and count >= chunk_lines:
