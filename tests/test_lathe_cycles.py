@@ -141,3 +141,28 @@ def test_profile_block_before_any_motion_word_is_a_line() -> None:
     assert list(zip(cycle.motion, cycle.x, cycle.z)) == [
         ("rapid", 168.0, 0.0), ("rapid", 168.0, 0.0), ("feed", 168.0, -333.0), ("feed", 170.0, -333.0),
         ("feed", 170.0, -415.0)]
+
+
+def test_profile_is_data_on_the_cycle_row() -> None:
+    """The profile the Q subroutine gives is carried as words on the cycle's row, not in its comment."""
+    op = gcodekit.gcode_to_operation(PROFILE.format(cycle="G70 Q100 X6 Z1 (finish)"), machine="linuxcnc", plan=False)
+    row = next(i for i in range(len(op.table)) if op.table.command(i).name == "lathe_finish")
+    cmd = op.table.command(row)
+    assert cmd.comment == "finish" and op.table.profiles[row] is cmd.profile
+    assert [[(w.letter, w.value) for w in b.words] for b in cmd.profile.blocks] == [
+        [("G", 1.0), ("X", 2.0), ("Z", 0.0)], [("G", 1.0), ("X", 4.0), ("Z", -5.0)], [("G", 1.0), ("X", 5.0)]]
+
+
+def test_exported_program_runs_without_the_subroutine() -> None:
+    """The G-code writer puts the profile after the cycle's comment, where reading the output finds it again."""
+    from gcodekit.export.gcode import GcodeExporter
+
+    op = gcodekit.gcode_to_operation(PROFILE.format(cycle="G71 Q100 X6 Z1 D0.2 I0.5 R0.3 (rough)"),
+                                     machine="linuxcnc", plan=False)
+    text = GcodeExporter("rs274ngc").to_gcode(op)
+    assert "O100" not in text.upper() and "(rough g7x profile: G1 X2 Z0; G1 X4 Z-5; G1 X5)" in text
+    again = gcodekit.gcode_to_operation(text, machine="linuxcnc", plan=False)
+    assert not again.diagnostics.items
+    cycle = next(i for i in range(len(again.table)) if again.table.command(i).name == "lathe_rough")
+    assert again.table.command(cycle).comment == "rough"
+    np.testing.assert_allclose(again.motions()[["x", "z"]].to_numpy(), op.motions()[["x", "z"]].to_numpy())

@@ -5,7 +5,8 @@ Behaviour mirrored: LinuxCNC 2.9 ``interp_g7x.cc`` (Debian 12 package
 
 Points are complex numbers ``z + x*1j`` in program coordinates (X a
 radius).  The profile is the chain of G0/G1/G2/G3 blocks of the ``Q``
-subroutine, starting at the cycle point (the block's X/Z).  The cycle
+subroutine (a :class:`~gcodekit.lathe_profile.LatheProfile`, read by the
+preprocess stage), starting at the cycle point (the block's X/Z).  The cycle
 mirrors and rotates the profile so that it always descends in X and Z
 (``_Profile.normalise``), works there, and maps every move back.
 
@@ -28,12 +29,11 @@ from __future__ import annotations
 
 import copy
 import math
-import re
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
+from ..lathe_profile import LatheProfile
 from ..limits import MotionBudget
-from ..parse.table import PROFILE_TAG
 
 TOLERANCE = 1e-6  # LinuxCNC's g7x tolerance
 #: rs274's ``equal`` (interp_internal.hh TOLERANCE_EQUAL): an arc to where the tool is is skipped
@@ -656,7 +656,6 @@ LATHE_CYCLES = {
     "lathe_rough_pockets": (71, 2), "lathe_face": (72, 0), "lathe_face_no_pockets": (72, 1),
     "lathe_face_pockets": (72, 2),
 }
-_WORD = re.compile(r"([a-z])([-+]?(?:\d+\.?\d*|\.\d+))")
 _MOTIONS = {0.0: 0, 1.0: 1, 2.0: 2, 3.0: 3}
 _OTHER_MOTIONS = frozenset((5.0, 5.1, 5.2, 33.0, 33.1, 38.2, 38.3, 38.4, 38.5, 73.0, 74.0, 76.0, 80.0) +
                            tuple(float(g) for g in range(81, 90)))
@@ -668,7 +667,7 @@ class CycleBlock:
 
     name: str
     params: dict
-    profile: str | None
+    profile: LatheProfile | None  # None: the Q subroutine was not found
     here: complex  # program position, z + x*1j
     scale: float  # mm per program unit
     incremental: bool
@@ -676,20 +675,6 @@ class CycleBlock:
     diameter: bool
     plane: int
     compensating: bool = False  # cutter compensation on: only G70 may run
-
-
-def profile_of(comment: str | None) -> str | None:
-    """The profile text the preprocess stage attached to a cycle block, or None."""
-    if not comment or PROFILE_TAG not in comment:
-        return None
-    return comment.split(PROFILE_TAG, 1)[1].strip()
-
-
-def program_comment(comment: str | None) -> str | None:
-    """A cycle block's comment as the program wrote it, without the profile (None if that leaves nothing)."""
-    if not comment or PROFILE_TAG not in comment:
-        return comment
-    return comment.split(PROFILE_TAG, 1)[0].strip() or None
 
 
 class LatheCycle(NamedTuple):
@@ -751,15 +736,14 @@ def _read_profile(block: CycleBlock, start: complex) -> list[dict]:
     k, motion, here = block.scale, 1, start
     halve = 2.0 if block.diameter else 1.0
     out = []
-    for text in block.profile.split(";"):
+    for profile_block in block.profile.blocks:
         words: dict[str, float] = {}
-        for letter, value in _WORD.findall(text.lower()):
-            if letter == "g":
-                g = float(value)
-                if g in _MOTIONS or g in _OTHER_MOTIONS:
-                    motion = _MOTIONS.get(g, -1)
+        for word in profile_block.words:
+            if word.letter == "G":
+                if word.value in _MOTIONS or word.value in _OTHER_MOTIONS:
+                    motion = _MOTIONS.get(word.value, -1)
             else:
-                words[letter.upper()] = float(value)
+                words[word.letter] = word.value
         end = 0j if block.incremental else here
         if "U" in words:
             if block.incremental:

@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Iterable
 
 from ..errors import Diagnostic, GcodeError, check_choice
+from ..lathe_profile import written_comment
 from ..parse.commands import MOTION_KINDS, Command, Kind
 from ..parse.table import MOTION_NAMES
 from ..syntax import Flavor, load_flavor
@@ -247,7 +248,7 @@ class GcodeExporter:
         """
         row: dict = {"line": cmd.line, "code": cmd.code, "name": cmd.name, "kind": cmd.kind.name.lower()}
         row.update(cmd.params)
-        row["comment"] = cmd.comment
+        row["comment"] = written_comment(cmd.comment, cmd.profile)  # a lathe cycle's profile goes as written
         row["text"] = cmd.text
         return row
 
@@ -319,7 +320,8 @@ class GcodeExporter:
         if extra_motion:
             state.target_motion = state.motion
 
-        comment = cmd.comment if self.comments else None
+        # a lathe cycle's profile is written after its comment, so the output runs without the subroutine
+        comment = written_comment(cmd.comment, cmd.profile) if self.comments else None
         shares_line = not (code in ("M117", "M118") and code in fl.string_codes) and not (
             code and not _LETTER_CODE.match(code) and (fl.wizards or code.startswith(fl.directive_prefix or "\0")))
         if comment is not None and not shares_line:

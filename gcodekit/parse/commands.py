@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import ClassVar
 
+from ..lathe_profile import LatheProfile, written_comment
+
 
 class Kind(IntEnum):
     """Command class of a row, stored as one byte per command."""
@@ -71,6 +73,9 @@ class Command:
         Normalized meaning from the flavor (``"linear"``), ``""`` if unknown.
     text : str
         Raw argument text of named commands (``ACCEL=500``).
+    profile : LatheProfile or None
+        A lathe cycle's (G70-G72) profile, from its ``Q`` subroutine (see
+        :mod:`gcodekit.lathe_profile`); written out after the comment.
     """
 
     code: str
@@ -79,6 +84,7 @@ class Command:
     comment: str | None = None
     name: str = ""
     text: str = ""
+    profile: LatheProfile | None = field(default=None, repr=False)
 
     kind: ClassVar[Kind] = Kind.CONFIG
 
@@ -90,8 +96,9 @@ class Command:
         words += [f"{k}{_format(v)}" for k, v in self.params.items()]
         if self.text:
             words.append(self.text)
-        if self.comment is not None:
-            words.append(f"; {self.comment}" if words else f";{self.comment}")
+        comment = written_comment(self.comment, self.profile)
+        if comment is not None:
+            words.append(f"; {comment}" if words else f";{comment}")
         return " ".join(words)
 
 

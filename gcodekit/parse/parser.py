@@ -23,6 +23,7 @@ from ..read import Blocks
 from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
+from .profiles import lathe_profiles
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
 from .word_checks import MODAL_USERS, WORD_USERS, stray_letters, stray_word_message, user_code_keys
 from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CCW, MOTION_CUBIC, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
@@ -100,7 +101,8 @@ class GcodeParser:
         block = rows["block"]
         first_row = np.full(len(blocks), -1, np.int64)
         first_row[block[::-1]] = np.arange(block.size)[::-1]
-        comment_rows = first_row[blocks.comment_block]
+        profiles, comments = lathe_profiles(blocks, block, np.flatnonzero(np.isin(rows["name"], self._lathe_ids)))
+        comment_rows = first_row[comments.block]
         parts = rows["parts_by_row"]
         named = {i: p.named for i, p in parts.items() if p.named is not None}
         texts = {i: p.text for i, p in parts.items() if p.text}
@@ -114,11 +116,12 @@ class GcodeParser:
             motion=rows["motion"],
             params=rows["params"],
             comment_rows=comment_rows.astype(np.int32),
-            comment_offsets=blocks.comment_offsets,
-            comment_data=blocks.comment_data,
+            comment_offsets=comments.offsets,
+            comment_data=comments.data,
             named=named,
             texts=texts,
             deleted=np.array(sorted(deleted), np.int64),
+            profiles=profiles,
         ).compact()
 
     # -- bulk path ------------------------------------------------------------

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..lathe_profile import LatheProfile
 from ..syntax.flavor import COMMANDS, code_label
 from .commands import COMMAND_CLASSES, Command, Kind
 
@@ -34,10 +35,6 @@ CYCLE_NAMES = ("cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_pe
                "cycle_bore_manual", "cycle_thread") + tuple(LATHE_CYCLE_NAMES := (
                    "lathe_finish", "lathe_rough", "lathe_rough_no_pockets", "lathe_rough_pockets",
                    "lathe_face", "lathe_face_no_pockets", "lathe_face_pockets"))
-
-#: The comment the preprocess stage gives a lathe cycle's line: its Q subroutine's blocks,
-#: ';'-separated, so the emulator runs the cycle without the subroutine (gcodekit.emulate.lathe)
-PROFILE_TAG = "g7x profile:"
 
 _SPARSE_BELOW = 0.02  # a parameter present in fewer rows than this is kept sparse
 
@@ -92,6 +89,9 @@ class CommandTable:
     deleted : ndarray of int64
         Rows from block-delete (``/``) lines, skipped when the machine's
         block-delete switch is on.
+    profiles : dict of int to LatheProfile
+        Lathe cycles (G70-G72) by row: the profile of the cycle's ``Q``
+        subroutine (see :mod:`gcodekit.lathe_profile`).
     """
 
     line: np.ndarray
@@ -107,6 +107,7 @@ class CommandTable:
     named: dict[int, tuple[str, str]] = field(default_factory=dict)
     texts: dict[int, str] = field(default_factory=dict)
     deleted: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    profiles: dict[int, LatheProfile] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(self.line.size)
@@ -157,6 +158,7 @@ class CommandTable:
             comment=self.comment_of(i),
             name=NAMES[int(self.name[i])],
             text=named[1] if named else self.texts.get(i, ""),
+            profile=self.profiles.get(i),
         )
 
     def compact(self) -> "CommandTable":
@@ -192,6 +194,7 @@ class CommandTable:
                     for c, size in zip(cols, sizes)])
         named = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.named.items()}
         texts = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.texts.items()}
+        profiles = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.profiles.items()}
         table = cls(
             line=_cat(parts, "line"),
             kind=_cat(parts, "kind"),
@@ -206,6 +209,7 @@ class CommandTable:
             named=named,
             texts=texts,
             deleted=np.concatenate([p.deleted + s for p, s in zip(parts, shift)]),
+            profiles=profiles,
         )
         assert len(table) == n
         return table.compact()

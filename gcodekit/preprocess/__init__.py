@@ -2,7 +2,7 @@
 
 Preprocessing rewrites a program's lines before they are read into words:
 parameters and expressions (:mod:`.parameters`, :mod:`.expressions`), O-word
-control flow and subprograms (:mod:`.flow`); wizards later.
+control flow and subprograms (:mod:`.flow`) and GER wizards (:mod:`.wizards`).
 Each step is a :class:`Stage` that maps a stream of :class:`SourceLine` to
 another, keeping every line's source file and 1-based line number so later
 diagnostics still point at what the user wrote.  :func:`run_stages` chains
@@ -12,45 +12,14 @@ stages lazily, so a large file streams through with bounded memory.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
-from typing import Iterable, Iterator, Protocol, runtime_checkable
+from typing import Iterable, Iterator
 
 from gcodekit.errors import Diagnostics, GcodeError
 from gcodekit.preprocess.expressions import evaluate as _evaluate
 from gcodekit.preprocess.expressions import parse
-from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, needs_parameters
 from gcodekit.preprocess.flow import ControlFlowStage
-
-
-@dataclass(frozen=True, slots=True)
-class SourceLine:
-    """One line of program text and where it came from.
-
-    Attributes
-    ----------
-    text : str
-        The line without its line ending.
-    line : int
-        1-based line number in ``file``.
-    file : str
-    """
-
-    text: str
-    line: int
-    file: str
-
-
-@runtime_checkable
-class Stage(Protocol):
-    """A preprocess step: a named map from lines to lines.
-
-    ``process`` reports problems to ``diagnostics`` (which raises in strict
-    mode) and, in lenient mode, goes on with the next line.
-    """
-
-    name: str
-
-    def process(self, lines: Iterable[SourceLine], diagnostics: Diagnostics) -> Iterator[SourceLine]: ...
+from gcodekit.preprocess.lines import SourceLine, Stage
+from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, needs_parameters
 
 
 def run_stages(

@@ -30,7 +30,7 @@ from gcodekit.preprocess.expressions import (
 )
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess import SourceLine
+    from gcodekit.preprocess.lines import SourceLine
     from gcodekit.syntax.flavor import Flavor
 
 #: Highest parameter number.  LinuxCNC's ``RS274NGC_MAX_PARAMETERS`` is 5602

@@ -176,6 +176,8 @@ def iter_source_blocks(lines: Iterable, flavor: Flavor, diagnostics: Diagnostics
     A loop can emit millions of lines: reading them a chunk at a time lets
     the later stages run on each chunk and drop it, so memory holds the
     columns, not the lines.  At least one (possibly empty) chunk is yielded.
+    A line's lathe profile (``profile``, see :mod:`gcodekit.lathe_profile`)
+    goes with each block read from it.
     """
     tokenizer = LineTokenizer(flavor, diagnostics)
     raw: list[RawBlock] = []
@@ -184,7 +186,12 @@ def iter_source_blocks(lines: Iterable, flavor: Flavor, diagnostics: Diagnostics
         if len(sl.text) > MAX_LINE_LENGTH:
             diagnostics.report(sl.line, 1, f"line is longer than {MAX_LINE_LENGTH} characters; skipped")
         else:
-            raw.extend(tokenizer.tokenize(sl.text, sl.line))
+            found = tokenizer.tokenize(sl.text, sl.line)
+            profile = getattr(sl, "profile", None)  # lines may be any objects with text and line
+            if profile is not None:
+                for block in found:
+                    block.profile = profile
+            raw.extend(found)
         count += 1
         if chunk_lines is not None and count >= chunk_lines:
             yield Blocks.from_raw(diagnostics.file, raw)

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..lathe_profile import LatheProfile
 from .tokenize import RawBlock
 
 
@@ -38,6 +39,7 @@ class Block:
     named: tuple[str, str] | None = None
     text: str | None = None
     deleted: bool = False
+    profile: LatheProfile | None = None
 
 
 @dataclass
@@ -59,8 +61,8 @@ class Blocks:
     comment_data : bytes
     extras : dict of int to RawBlock
         The few blocks with flags (``G28 W``), named commands
-        (``SET_VELOCITY_LIMIT``, ``M117 text``), code values (``M60=1``) or
-        the block-delete mark, keyed by block index.
+        (``SET_VELOCITY_LIMIT``, ``M117 text``), code values (``M60=1``),
+        the block-delete mark or a lathe cycle's profile, keyed by block index.
     """
 
     file: str
@@ -104,6 +106,7 @@ class Blocks:
             named=extra.named[:2] if extra and extra.named else None,
             text=extra.text if extra else None,
             deleted=bool(extra and extra.deleted),
+            profile=extra.profile if extra else None,
         )
 
     @classmethod
@@ -159,5 +162,6 @@ class Blocks:
             comment_offsets=offsets,
             comment_data=b"".join(encoded),
             extras={i: b for i, b in enumerate(raw)
-                    if b.flags or b.named or b.text or b.code_value is not None or b.deleted or b.assignments},
+                    if b.flags or b.named or b.text or b.code_value is not None or b.deleted or b.assignments
+                    or b.profile is not None},
         )

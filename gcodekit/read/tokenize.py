@@ -12,6 +12,7 @@ import re
 from dataclasses import dataclass, field
 
 from ..errors import Diagnostics
+from ..lathe_profile import LatheProfile
 from ..syntax import Flavor
 from ..syntax.flavor import code_label
 
@@ -29,7 +30,11 @@ _CALL = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)\s*\(")
 
 @dataclass(slots=True)
 class RawBlock:
-    """One block as read from text: words, comments and rare extras."""
+    """One block as read from text: words, comments and rare extras.
+
+    ``profile`` is not read from the text: it is the lathe profile the
+    preprocess stage attached to the block's line (see :func:`gcodekit.read.iter_source_blocks`).
+    """
 
     line: int
     words: list[tuple[str, float, int]] = field(default_factory=list)
@@ -40,6 +45,7 @@ class RawBlock:
     code_value: float | None = None
     assignments: list[tuple[str, float, int]] = field(default_factory=list)
     deleted: bool = False
+    profile: LatheProfile | None = None
 
     def is_empty(self) -> bool:
         return not (self.words or self.comments or self.flags or self.named or self.text or self.assignments)

@@ -46,10 +46,10 @@ import numpy as np
 
 from ..emulate.arcs import PLANES
 from ..export.gcode import format_number
-from ..emulate.lathe import profile_of, program_comment
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
-from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, NAME_ID, NAMES, PROFILE_TAG
+from ..lathe_profile import written_comment
+from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, NAME_ID, NAMES
 from ..units import MM_PER_INCH
 from .cycle_words import cycle_offset, diameter_words, lathe_defaults, length_words, level_words, rewrite_profile
 
@@ -219,15 +219,15 @@ class Transpiler:
 
     def _comment(self, row: int, cmd, k: int) -> str:
         """The command's comment as written out; a lathe cycle's profile takes the stage's units and offsets."""
-        text = program_comment(cmd.comment)
-        profile = profile_of(cmd.comment)
-        if profile is not None and k < 6:  # the cycle line is still there: so must its profile be
+        text = cmd.comment
+        if cmd.profile is not None and k < 6:  # the cycle line is still there: so must its profile be
+            body = None
             if k >= 1:
                 offset = self._offset(row) / self.unit if k >= 2 else np.zeros(3)
-                profile = rewrite_profile(profile, scale=self._scale(row), halve=bool(self._diameter_rows[row]),
-                                          offset_x=offset[0], offset_z=offset[2],
-                                          arc_absolute=bool(self._arc_absolute_rows[row]), precision=self.precision)
-            text = f"{text} {PROFILE_TAG} {profile}" if text else f"{PROFILE_TAG} {profile}"
+                body = rewrite_profile(cmd.profile, scale=self._scale(row), halve=bool(self._diameter_rows[row]),
+                                       offset_x=offset[0], offset_z=offset[2],
+                                       arc_absolute=bool(self._arc_absolute_rows[row]), precision=self.precision)
+            text = written_comment(text, cmd.profile, body)
         return f" ({_paren(text)})" if text else ""
 
     def _from_waypoints(self, row: int, k: int, points: np.ndarray, comment: str) -> list[str]:

@@ -10,7 +10,7 @@ which waypoint shows the offset depend on the cycle:
   and R is a level on the normal like Z, as is G87's K (in G17);
 * lathe cycles (G70-G72): X/Z are the cycle point, the first rapid's end;
   ``Q`` names the profile subroutine and ``P`` counts passes (not lengths);
-  the profile, carried in the line's comment, is rewritten the same way,
+  the profile, written in the line's comment, is rewritten the same way,
   and the lengths G71/G72 default in program units (I 1, R 0.5) are written
   out when the units change;
 * G76 threading: ``P`` (the pitch) is a length, I/J/K are diameters in G7
@@ -19,12 +19,11 @@ which waypoint shows the offset depend on the cycle:
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 
 from ..emulate.arcs import PLANES
 from ..export.gcode import format_number
+from ..lathe_profile import LatheProfile, ProfileWord
 from ..parse.table import LATHE_CYCLE_NAMES
 
 #: Words that are lengths, unless the command has its own set below
@@ -32,7 +31,6 @@ LENGTH_WORDS = frozenset("XYZUVWIJKRQ")
 _OWN_LENGTH_WORDS = {**dict.fromkeys(LATHE_CYCLE_NAMES, frozenset("XZUWDEIR")),
                      "cycle_thread": frozenset("XZIJKPE"),
                      "coordinate_data": frozenset("XYZUVW")}  # G10 L2/L20: R is a rotation
-_PROFILE_WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
 
 
 def length_words(name: str) -> frozenset[str]:
@@ -86,18 +84,18 @@ def lathe_defaults(name: str, params: dict) -> dict:
     return {letter: value for letter, value in defaults.items() if letter not in params}
 
 
-def rewrite_profile(profile: str, *, scale: float, halve: bool, offset_x: float, offset_z: float,
+def rewrite_profile(profile: LatheProfile, *, scale: float, halve: bool, offset_x: float, offset_z: float,
                     arc_absolute: bool, precision: int) -> str:
-    """A lathe profile (``;``-separated blocks) in the output's units and frame.
+    """The written form's body of a lathe profile in the output's units and frame.
 
     ``scale``: output units per program unit; ``halve``: X and U are
     diameters to write as radii; offsets (output units) move X and Z, and I
-    and K when arc centres are absolute (G90.1).
+    and K when arc centres are absolute (G90.1).  Other words stay as written.
     """
-    def word(match: re.Match) -> str:
-        letter, value = match.group(1).upper(), float(match.group(2))
+    def word(w: ProfileWord) -> str | None:
+        letter, value = w.letter, w.value
         if letter not in "XZUWIKRAC":
-            return match.group(0)
+            return None
         value *= scale
         if halve and letter in "XU":
             value /= 2.0
@@ -107,4 +105,4 @@ def rewrite_profile(profile: str, *, scale: float, halve: bool, offset_x: float,
             value += offset_z
         return f"{letter}{format_number(value, precision)}"
 
-    return _PROFILE_WORD.sub(word, profile)
+    return profile.text(word)

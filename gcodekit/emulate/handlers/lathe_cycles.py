@@ -6,7 +6,7 @@ import numpy as np
 
 from ...parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, MOTION_NONE, MOTION_RAPID
 from ..arcs import PLANES, centres, reach_tolerance
-from ..lathe import CycleBlock, LatheCycleError, Move, profile_of, run_lathe_cycle
+from ..lathe import CycleBlock, LatheCycleError, Move, run_lathe_cycle
 from ..state import AXES
 from .registry import AFTER_LATHE_CYCLE, LATHE_CYCLE, Block, Context, Outcome, Waypoint, handles
 from .words import move_to, program_target
@@ -26,7 +26,7 @@ def _moves(ctx: Context, block: Block) -> Outcome | None:
     """The cycle's moves as waypoints, the last one the block's own; None (reported) if it is refused."""
     s, line = ctx.state, block.line
     program = s.program_position()
-    cycle = CycleBlock(block.name, block.params, profile_of(block.command.comment), complex(program[2], program[0]),
+    cycle = CycleBlock(block.name, block.params, block.command.profile, complex(program[2], program[0]),
                        s.units, s.incremental, s.arc_incremental, s.diameter, s.plane, s.compensating)
     try:
         point, moves, profile_end = run_lathe_cycle(cycle, ctx.budget)
