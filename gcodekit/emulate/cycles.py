@@ -82,7 +82,6 @@ class CycleState:
 
     name: str = ""
     r: float | None = None
-    r_words: float = 0.0  # R as written, in the program's units
     z: float | None = None
     p: float = 0.0
     q: float | None = None
@@ -123,26 +122,10 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
     TooManyMotions
         The block would make more moves than ``budget`` has room for.
     """
-    if name:
-        cycle.name = name
+    _take_words(name, params, cycle, plane=plane, scale=scale, dwell_unit=dwell_unit, same_mode=same_mode)
     (a, b, axis), _ = PLANES[plane]
     letter = "XYZ"[axis]
     first, second = "XYZ"[a], "XYZ"[b]
-    if not same_mode:
-        _check_new_mode_words(cycle.name, params, plane)
-    if "R" in params:
-        cycle.r = params["R"] * scale[axis]
-        cycle.r_words = params["R"]
-    if letter in params:
-        cycle.z = params[letter] * scale[axis]
-    if "P" in params:
-        cycle.p = params["P"] * dwell_unit
-    if "Q" in params:
-        cycle.q = params["Q"] * scale[axis]
-    if cycle.name == "cycle_back_bore":
-        _back_bore_words(cycle, params, plane, scale)
-    if cycle.r is None or cycle.z is None:
-        raise ValueError(f"canned cycle needs R and {letter} (none in force)")
     repeats = int(params.get("L", 1))
     if repeats == 0:
         raise ValueError("Cannot do zero repeats of cycle")
@@ -207,6 +190,33 @@ def run_cycle(name: str, params: dict, cycle: CycleState, *, program: np.ndarray
     if cycle.name == "cycle_bore_manual":
         believed[axis] = clear  # rs274 sets its current point to the clear height after every cycle
     return CycleMoves(steps, believed)
+
+
+def _take_words(name: str, params: dict, cycle: CycleState, *, plane: int, scale: np.ndarray, dwell_unit: float,
+                same_mode: bool) -> None:
+    """The block's sticky words (R, the drilling axis, P, Q, G87's I/J/K) into the cycle mode, in mm and s.
+
+    Raises ValueError when R or the drilling-axis level is in force neither
+    here nor from an earlier block of the mode.
+    """
+    if name:
+        cycle.name = name
+    axis = PLANES[plane][0][2]
+    letter = "XYZ"[axis]
+    if not same_mode:
+        _check_new_mode_words(cycle.name, params, plane)
+    if "R" in params:
+        cycle.r = params["R"] * scale[axis]
+    if letter in params:
+        cycle.z = params[letter] * scale[axis]
+    if "P" in params:
+        cycle.p = params["P"] * dwell_unit
+    if "Q" in params:
+        cycle.q = params["Q"] * scale[axis]
+    if cycle.name == "cycle_back_bore":
+        _back_bore_words(cycle, params, plane, scale)
+    if cycle.r is None or cycle.z is None:
+        raise ValueError(f"canned cycle needs R and {letter} (none in force)")
 
 
 #: The words a cycle needs in the block that starts it, besides R and the drilling axis (rs274's checks)
