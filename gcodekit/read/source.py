@@ -75,10 +75,33 @@ class _Stream:
         self.unsupported = next((what for magic, what in _UNSUPPORTED if head.startswith(magic)), "")
         self.decoder = None  # set when the text is UTF-16
         self.started = False
+        self.failed: BaseException | None = None  # the archive broke after the data last returned
 
     def read(self, size: int) -> bytes:
-        """Up to ``size`` bytes, from one read of the container (so a damaged archive's error
-        comes on the read after the last good data, which is kept)."""
+        """About ``size`` bytes (fewer only at the end).
+
+        A damaged archive's error comes on the read after the last good data,
+        which is returned first: the container is read a piece at a time.
+        """
+        if self.failed is not None:
+            raise self.failed
+        parts, got = [], 0
+        while got < size:
+            try:
+                data = self._read_piece(size - got)
+            except _ARCHIVE_ERRORS as exc:
+                if not parts:
+                    raise
+                self.failed = exc
+                break
+            if not data:
+                break
+            parts.append(data)
+            got += len(data)
+        return b"".join(parts)
+
+    def _read_piece(self, size: int) -> bytes:
+        """Up to ``size`` bytes from one read of the container, decoded to UTF-8."""
         while True:
             data = self.raw.read1(size)  # type: ignore[attr-defined]
             if not self.started:
