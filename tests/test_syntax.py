@@ -259,3 +259,13 @@ def test_ini_disabling_fanuc_subprograms_refuses_m98(tmp_path):
     allowed = tmp_path / "test-fanuc.ini"
     allowed.write_text("[RS274NGC]\nDISABLE_FANUC_STYLE_SUB = 0\n")
     assert len(gcodekit.gcode_to_operation(program, plan=False, ini_file=str(allowed)).motions()) == 13
+
+
+def test_e_words_on_one_long_line():
+    """Found by the fuzz suite (seed 17): one 120 000-character line of moves took the E-word
+    search 40 s (a regex backtracking over every pair of positions); the answer is unchanged."""
+    from gcodekit.syntax.detect import _e_words_on_moves
+
+    line = "G1 X1 " * 20_000
+    assert not _e_words_on_moves(line) and _e_words_on_moves(line + " E0.5")
+    assert detect_flavor(line + "\n").name == detect_flavor("G1 X1\n").name

@@ -44,7 +44,10 @@ _COMMENTS = re.compile(r"\([^()\n]*\)|;[^\n]*")
 _GM_CODE = re.compile(r"(?<![A-Za-z_#<])([GgMm])[ \t]*0*(\d+(?:\.\d+)?)")
 # Extended commands and wizards start a line with two letters: PRINT_START, Pocket.
 _NAME = re.compile(r"^[ \t]*([A-Za-z_]{2}\w*)", re.M)
-_E_WORD = re.compile(r"^[^\n]*\b[Gg]0*[0-3]\b[^\n]*[ \t][Ee][-+]?\.?\d", re.M)
+# An E word after a G0-G3 on its line, found in two linear searches (one regex with both
+# backtracks over every pair of positions: minutes on one long line)
+_MOVE_CODE = re.compile(r"\b[Gg]0*[0-3]\b")
+_E_AFTER = re.compile(r"[ \t][Ee][-+]?\.?\d")
 
 
 @dataclass(frozen=True)
@@ -133,10 +136,16 @@ class _Evidence:
     codes: set[str]
     style: str  # the comment style most lines use
     suffix: str
+    e_words: bool = False  # E words on moves (see _e_words_on_moves)
 
-    @property
-    def e_words(self) -> bool:
-        return _E_WORD.search(self.bare) is not None
+
+def _e_words_on_moves(bare: str) -> bool:
+    """Whether some line has an E word after a G0-G3 (an extruding move)."""
+    for line in bare.splitlines():
+        move = _MOVE_CODE.search(line)
+        if move and _E_AFTER.search(line, move.end()):
+            return True
+    return False
 
 
 def _score(rules: DetectRules, evidence: _Evidence) -> tuple[float, list[str]]:
@@ -219,8 +228,10 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     """
     lines = text_head[:HEAD_CHARS].splitlines()[:HEAD_LINES]
     head = "\n".join(lines)
-    evidence = _Evidence(head, _COMMENTS.sub("", head), _codes_in(head), _comment_style(lines),
-                         os.path.splitext(os.fspath(filename))[1].lower() if filename is not None else "")
+    bare = _COMMENTS.sub("", head)
+    evidence = _Evidence(head, bare, _codes_in(head), _comment_style(lines),
+                         os.path.splitext(os.fspath(filename))[1].lower() if filename is not None else "",
+                         _e_words_on_moves(bare))
     e_words, style = evidence.e_words, evidence.style
     scored = []
     for rules in _all_rules():
