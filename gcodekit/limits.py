@@ -63,7 +63,6 @@ class TooManyMotions(Exception):
     def __init__(self, count: float, room: int, limit: int):
         many = f"{count:,.0f}" if count < 1e18 else "countless"
         super().__init__(f"{many} motions, more than the {max(room, 0):,} left of max_motions={limit:,}")
-        self.count = count
 
 
 class MotionBudget:
