@@ -147,6 +147,9 @@ class MachineConfig:
     screw_displacement : float
         cm^3 of material a screw extruder delivers per revolution; 0 leaves
         its deposited volume unknown (NaN).
+    laser : bool
+        The spindle output drives a laser (GRBL laser mode): S is beam power,
+        the ``power`` column shows it on the moves that burn.
     """
 
     name: str
@@ -185,6 +188,7 @@ class MachineConfig:
     cycle_retract: str = "initial"
     table_axis: str = ""
     screw_displacement: float = 0.0
+    laser: bool = False
 
     def __hash__(self) -> int:
         return hash(self.name)

@@ -66,6 +66,7 @@ class GcodeParser:
         self._modal_motion = self.flavor.block_split != "single"  # firmware needs a code on every move
         self._name_cache: dict[int, int] = {}
         self._unknown_reported: set[str] = set()
+        self._extruder_letters = tuple(k for k, v in self.flavor.words.items() if v == "e" and k != "E")
         self._cycle_ids = np.array([NAME_ID[n] for n in CYCLE_NAMES], np.uint8)
         self._lathe_ids = np.array([NAME_ID[n] for n in LATHE_CYCLE_NAMES], np.uint8)
 
@@ -93,6 +94,7 @@ class GcodeParser:
         fast = self._simple_rows(blocks, simple, is_code, is_param)
         slow = self._compound_rows(blocks, np.flatnonzero(compound))
         rows = _merge_rows(fast, slow)
+        _read_as_e(rows["params"], self._extruder_letters)
         rows["line"] = blocks.block_line[rows["block"]]
         self._classify(rows)
         return self._table(blocks, rows)
@@ -397,8 +399,9 @@ class GcodeParser:
             elif code in self.flavor.other_codes:
                 self.diagnostics.warn(line, 1, f"{code} is a {self.flavor.name} code gcodekit does not emulate; "
                                       "kept as a generic command")
-            else:
-                self.diagnostics.warn(line, 1, f"{code} is not a {self.flavor.name} code; kept as a generic command")
+            else:  # firmware add codes freely (M900, M620, ...): say once, quietly, that it does nothing here
+                self.diagnostics.report(line, 1, f"{code} has no meaning in gcodekit's {self.flavor.name} flavor; "
+                                        "kept as a command without effect on the path", severity="info")
 
 
 def _forward_fill_modes(sets: np.ndarray, initial: int) -> np.ndarray:
@@ -407,6 +410,15 @@ def _forward_fill_modes(sets: np.ndarray, initial: int) -> np.ndarray:
     np.maximum.accumulate(idx, out=idx)
     out = np.where(idx >= 0, sets[np.maximum(idx, 0)], initial).astype(np.uint8)
     return out
+
+
+def _read_as_e(params: dict, letters: tuple[str, ...]) -> None:
+    """The flavor's other extruder letters (MakerBot's A and B) become E words, one extruder at a time."""
+    for letter in letters:
+        col = params.pop(letter, None)
+        if col is not None:
+            e = params.get("E")
+            params["E"] = col if e is None else np.where(np.isnan(col), e, col)
 
 
 def _merge_rows(fast: dict, slow: dict) -> dict:

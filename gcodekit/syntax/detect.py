@@ -21,14 +21,17 @@ HEAD_CHARS = 64 * 1024
 HEAD_LINES = 4000
 
 #: Points per piece of evidence.  A header match (slicer banner, dialect-only
-#: command) outweighs any number of shared codes a short head can hold; the
-#: dialect's own file extension (``.ngc``) outweighs one header, one unrelated
-#: dialects share (``.nc``, ``.tap``) is only a hint; what the dialect cannot
-#: read (``against``) outweighs a header and what else a short head holds.
+#: command) outweighs any number of shared codes a short head can hold; what
+#: the dialect cannot read (``against``) outweighs a header and what else a
+#: short head holds.  The file name is weak evidence: tools name files as
+#: their users like (CAM posts write ``.gcode``, slicers ``.nc``), so the
+#: dialect's own extension (``.ngc``) only tips a balance the content left
+#: even, and alone stays below :data:`MIN_SCORE`; one unrelated dialects
+#: share (``.nc``, ``.tap``) counts less still.
 HEADER_POINTS = 10.0
 AGAINST_POINTS = 20.0
-EXTENSION_POINTS = 12.0
-SHARED_EXTENSION_POINTS = 1.0
+EXTENSION_POINTS = 2.0
+SHARED_EXTENSION_POINTS = 0.5
 HINT_POINTS = 3.0
 E_WORD_POINTS = 2.0
 CODE_POINTS = 1.0
@@ -190,11 +193,13 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     banners such as ``;FLAVOR:Marlin``, dialect-only syntax such as
     LinuxCNC's ``o<name> sub`` and ``#<name>`` or Klipper's
     ``PRINT_START``), 20 taken away for each ``against`` regex found (text
-    the dialect cannot read so: words after ``;`` in Fanuc), 12 for one of
-    the flavor's file extensions (``.ngc``) and 1 for one it shares with
-    other dialects (``.nc``, ``.tap``), 3 for each ``hints`` regex found in the code,
-    2 for E words on moves if the flavor extrudes, 1 for each typical code
-    present and 1 for the usual comment style.  The best score wins; equal
+    the dialect cannot read so: words after ``;`` in Fanuc, a line that is
+    only a parenthesised comment in a printer firmware), 2 for one of the
+    flavor's file extensions (``.ngc``) and 0.5 for one it shares with
+    other dialects (``.nc``, ``.tap``) -- the name alone never decides --,
+    3 for each ``hints`` regex found in the code, 2 for E words on moves if
+    the flavor extrudes, 1 for each typical code present and 1 for the usual
+    comment style.  The best score wins; equal
     scores go to the higher ``priority``.  Below 3 points the evidence is
     too thin and a default is used: ``"marlin"`` for programs with E words
     on moves and without parenthesised comments, ``"rs274ngc"`` (the
