@@ -242,7 +242,8 @@ def _text(r: dict[str, Any]) -> str:
         f"  bounds     min {' '.join(fmt(v) for v in b['min'])}   max {' '.join(fmt(v) for v in b['max'])} mm",
         f"  distance   feed {d['feed']:.1f}  rapid {d['rapid']:.1f}  extruding {d['extrude']:.1f} mm",
         f"  time       {_duration(r['time_s'])}  "
-        + (f"(planned like {r['planner']})" if r["planner"] else "(length / feed: no planner for this machine)"),
+        + (f"(planned like {r['planner']})" if r["planner"] else "(length / feed: no planner for this machine)")
+        + (f", not counting {r['untimed_moves']} moves with no feed rate" if r.get("untimed_moves") else ""),
     ]
     if r["layers"] is not None:
         filament = f"   filament {r['filament_mm']:.1f} mm" if r["filament_mm"] is not None else ""

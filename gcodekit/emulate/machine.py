@@ -335,6 +335,8 @@ class Machine:
             feed = feed_words  # 1/min, for this block only
         else:
             feed = _forward_fill(feed_words, s.feed)
+        if not s.feed_given:
+            self._note_boot_feed(t, rows, feed_words, motion, position - start_pos)
 
         de = self._extrusion(t, rows, moving)
         delta = position - start_pos
@@ -508,14 +510,30 @@ class Machine:
                 arc = motion[first] in (MOTION_CW, MOTION_CCW)
                 self.diagnostics.report(int(t.line[rows][first]), 1, "Cannot make arc with zero feed rate" if arc
                                         else "Cannot do g1 with zero feed rate", kind="machine")
-            elif bad.any():
-                first = int(np.flatnonzero(bad)[0])
-                self.warn_once("feed", int(t.line[rows][first]), "move with no feed rate (F) in force; its time is unknown")
-                time[bad] = np.nan
+            elif bad.any() and "feed" not in self._warned:
+                # no boot feed (GRBL's error 22, "undefined feed rate"; a Fanuc's feed-zero alarm)
+                self._warned.add("feed")
+                self.diagnostics.report(int(t.line[rows][int(np.flatnonzero(bad)[0])]), 1,
+                                        "feed move with no feed rate (F) in force: the controller refuses it; "
+                                        "its time is not counted", kind="machine")
+            time[bad] = np.nan  # never an invented time: the summary counts these moves as untimed
         dwell = kind == Kind.DWELL
         if dwell.any():
             time[dwell] = self._dwell_times(t, rows, dwell)
         return time
+
+    def _note_boot_feed(self, t, rows, feed_words, motion, delta) -> None:
+        """Once: an info where a move runs at the firmware's boot feed, before any F word."""
+        given = np.flatnonzero(~np.isnan(feed_words))
+        end = int(given[0]) if given.size else feed_words.size
+        feeding = (motion >= MOTION_LINEAR) | ((motion == MOTION_RAPID) & self.rapid_is_feed)
+        before = np.flatnonzero(feeding[:end] & (np.abs(delta[:end]).max(axis=1) > 0))
+        if before.size and self.config.initial_feed > 0:
+            self.diagnostics.report(int(t.line[rows][int(before[0])]), 1, "move before any F word: it runs at the "
+                                    f"firmware's boot feed rate, {self.config.initial_feed:g} mm/min (the machine's "
+                                    "initial_feed)", severity="info")
+        if given.size or before.size:
+            self.state.feed_given = True
 
     def _dwell_times(self, t, rows, dwell) -> np.ndarray:
         p = _dense(t.params["P"], rows)[dwell] if "P" in t.params else np.full(int(dwell.sum()), np.nan)

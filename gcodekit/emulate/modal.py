@@ -114,6 +114,7 @@ class ModalHandler:
             keep = ctx.config.units_keep_feed
             units = UNITS[block.name] if block.name in UNITS and not keep else ctx.state.units
             ctx.state.feed = params["F"] * units
+            ctx.state.feed_given = True
 
     # -- output -------------------------------------------------------------------
 
@@ -123,7 +124,7 @@ class ModalHandler:
         distance = self._length(before, point, motion, [w.values.get(k, np.nan) for k in ("cx", "cy", "cz")])
         rate = w.values["feed"] if "feed" in w.values and motion != MOTION_RAPID else self._rate(motion)
         dwell = w.values.pop("dwell", 0.0)
-        w.values.update(distance=distance, time=(distance / (rate / 60.0) if distance and rate > 0 else 0.0) + dwell,
+        w.values.update(distance=distance, time=_move_time(distance, rate) + dwell,
                         de=0.0)
         for k in ("cx", "cy", "cz"):
             w.values.setdefault(k, np.nan)
@@ -152,10 +153,17 @@ class ModalHandler:
         rate = self._rate(outcome.motion) if outcome.feed is None else outcome.feed
         path = distance or abs(outcome.de)
         out["distance"][row] = distance
-        out["time"][row] = (path / (rate / 60.0) if path and rate > 0 else 0.0) + outcome.dwell
+        out["time"][row] = _move_time(path, rate) + outcome.dwell
         out["de"][row] = outcome.de
         out["feed"][row] = rate if outcome.feed is not None else s.feed
         out["motion"][row] = outcome.motion
         out["cx"][row], out["cy"][row], out["cz"][row] = outcome.centre
         out["spindle"][row] = s.speed * s.spindle
         s.fill_columns(row, out)
+
+
+def _move_time(path: float, rate: float) -> float:
+    """Seconds to go ``path`` mm at ``rate`` mm/min; NaN (unknown, never invented) with no rate."""
+    if not path:
+        return 0.0
+    return path / (rate / 60.0) if rate > 0 else float("nan")

@@ -54,6 +54,7 @@ class MachineState:
     plane: int = 17
     feed: float = np.nan  # mm/min, or 1/min in inverse-time mode
     feed_mode: str = "per_minute"  # "inverse_time" (G93), "per_rev" (G95)
+    feed_given: bool = False  # an F word (or the first move, at the boot feed) came; see Machine._note_boot_feed
     e_relative: bool = False  # M83
     e_program: float = 0.0  # E coordinate as the program sees it (mm)
     e_total: float = 0.0  # filament pushed so far (mm)

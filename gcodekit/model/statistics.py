@@ -51,6 +51,8 @@ def operation_statistics(op: "Operation") -> dict[str, Any]:
             "extrude": float(distance[extruding].sum()),
         },
         "time_s": float(np.nansum(w["time"])),
+        # moves whose time gcodekit cannot know (a feed move with no feed rate): left out of time_s
+        "untimed_moves": int(np.count_nonzero(moving & np.isnan(np.asarray(w["time"], float)))),
         "tools": sorted(int(t) for t in np.unique(w["tool"][moving])) if moving.any() else [],
         "bounds": op.get_bounds(),
     }
@@ -73,8 +75,10 @@ def summary(op: "Operation") -> dict[str, Any]:
     the report's summary and the notebooks' first table.
 
     Keys: ``file, flavor, machine, process, planner, lines, commands, moves,
-    bounds, distance_mm, time_s, layers, filament_mm, filament_convention,
-    filament_pushed_mm, volume_mm3, mass_g, tools, diagnostics`` (each with
+    bounds, distance_mm, time_s, untimed_moves`` (moves left out of
+    ``time_s`` because no feed rate was in force), ``layers, filament_mm,
+    filament_convention, filament_pushed_mm, volume_mm3, mass_g, tools,
+    diagnostics`` (each with
     its ``file``, ``line``, ``column``, ``severity``, ``message``, ``text``),
     ``diagnostics_dropped``, ``diagnostics_total`` and ``errors``.  Volume and
     mass are made from ``filament_mm`` for filament printers, else None.
@@ -87,7 +91,8 @@ def summary(op: "Operation") -> dict[str, Any]:
         "machine": machine.name if machine else None,
         "process": machine.process if machine else "generic",
         "planner": (machine.planner or None) if machine else None,
-        **{key: stats[key] for key in ("lines", "commands", "moves", "bounds", "distance_mm", "time_s", "layers",
+        **{key: stats[key] for key in ("lines", "commands", "moves", "bounds", "distance_mm", "time_s", "untimed_moves",
+                                       "layers",
                                        "filament_mm", "filament_convention", "filament_pushed_mm")},
         "volume_mm3": None,
         "mass_g": None,

@@ -78,6 +78,9 @@ def apply_plan(op: "Operation", moves: PlannerMoves | PlannedMoves, result: Plan
     planned = np.bincount(moves.waypoint, weights=result.duration_t, minlength=n)
     has_moves = np.bincount(moves.waypoint, minlength=n) > 0
     w["time"] = np.where(has_moves, planned, np.where(w["motion"] > 0, 0.0, w["time"]))
+    # a feed move with no feed in force has no time a planner could know (its minimum speed is no answer)
+    unknown = (np.asarray(w["motion"]) >= 2) & ~(np.asarray(w["feed"], float) > 0) & (np.asarray(w["distance"]) > 0)
+    w["time"] = np.where(unknown, np.nan, w["time"])
     op.plan = (moves.planned() if isinstance(moves, PlannerMoves) else moves, result)
     op._elapsed = None
 

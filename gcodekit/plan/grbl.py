@@ -29,6 +29,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..parse.table import MOTION_RAPID
+from .caps import report_feed_caps
 from .lookahead import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
 from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before
 
@@ -175,6 +176,7 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
     # plan_compute_profile_nominal_speed
     nominal = np.where(rapid, rapid_rate, np.minimum(programmed, rapid_rate))
     nominal = np.maximum(np.nan_to_num(nominal, nan=MINIMUM_FEED_RATE), MINIMUM_FEED_RATE)
+    report_feed_caps(op, moves, rapid_rate, "$110-$112")
 
     rest_before = happens_before(moves, command_rows(op, names=REST_NAMES)) | _spindle_syncs(op, moves, config)
     rest_before[0] = True

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...syntax import load_flavor
 from ..state import AXES, rotate_xy
 from ..tooltable import Tool
 from .registry import T_WORD, Block, Context, handles
@@ -27,9 +28,14 @@ def check_tool(ctx: Context, number: int, line: int) -> None:
     config = ctx.config
     if number and config.tool_table and number not in ctx.tools:
         ctx.error(line, f"Requested tool {number} not found in the tool table")
-    elif number and not config.tool_table and config.process != "additive":
+    elif number and not config.tool_table and config.process != "additive" and _reads_tool_lengths(config.flavor):
         ctx.warn_once("no tool table", line, f"no tool table: tool {number} (and every other) is taken to have no "
                       "length or diameter; LinuxCNC refuses a tool its table lacks (give the machine a tool_table)")
+
+
+def _reads_tool_lengths(flavor: str) -> bool:
+    """Whether the machine's dialect applies a tool table's lengths (G43); GRBL's has no table."""
+    return "tool_length_offset" in load_flavor(flavor).codes.values()
 
 
 @handles(T_WORD)
