@@ -218,8 +218,11 @@ class Machine:
             self.state.motion_code = int(table.number[setting[-1]])
         if cursor < n:
             self._hold(cursor, n, out)
-            if not self.out_of_budget:
-                self.warn_once("ended", int(table.line[cursor]), "blocks after the program end (M2/M30) are not run")
+            # comments (and '%', which makes no row) after the end are no blocks left unrun
+            unrun = np.flatnonzero(np.asarray(table.kind[cursor:]) != Kind.COMMENT)
+            if unrun.size and not self.out_of_budget:
+                self.warn_once("ended", int(table.line[cursor + int(unrun[0])]),
+                               "blocks after the program end (M2/M30) are not run")
         return _constants_as_views(_with_extra_waypoints(out, extra, n))
 
     def _out_of_budget(self, line: int, problem: str) -> None:

@@ -170,7 +170,9 @@ def scan(data: bytes, flavor: Flavor, max_line_length: int | None = None) -> Sca
     odd_code = ((code_letter == ord("G")) | (code_letter == ord("M"))) & ~((value >= 0) & (value < 10000))
     line_ok[token_line[odd_code]] = False  # the reference tokenizer reports it
     if flavor.string_codes:  # the rest of an M23/M117 line is its argument, not words
-        codes = code_letter.astype(np.int64) * 1_000_000 + np.round(value * 10).astype(np.int64)
+        # only G/M numbers in range make a code key (a long digit run elsewhere is no integer)
+        tenths = np.round(np.where(odd_code | ~np.isfinite(value) | (np.abs(value) >= 1e12), -1.0, value) * 10)
+        codes = code_letter.astype(np.int64) * 1_000_000 + tenths.astype(np.int64)
         line_ok[token_line[np.isin(codes, _string_code_keys(flavor))]] = False
 
     keep_tok = line_ok[token_line]
