@@ -70,6 +70,7 @@ DERIVED_COLUMNS: tuple[Column, ...] = (
     Column("start_v", "mm/s", "float64", "planned speed entering the step (first firmware move)"),
     Column("cruise_v", "mm/s", "float64", "fastest planned cruise speed of the step"),
     Column("end_v", "mm/s", "float64", "planned speed leaving the step (last firmware move)"),
+    Column("power", "S", "float64", "laser beam power in S units (full at GRBL's $30), 0 unlit; laser machines only"),
     Column("accel", "mm/s^2", "float64", "acceleration the planner used for the step's first move"),
 )
 

@@ -28,7 +28,8 @@ import numpy as np
 if TYPE_CHECKING:
     from .operation import Operation
 
-__all__ = ["depositing", "depositing_of", "screw_extruder", "features", "layers", "waypoint_rows", "row_labels"]
+__all__ = ["depositing", "depositing_of", "screw_extruder", "features", "layers", "waypoint_rows", "row_labels",
+           "laser_power"]
 
 
 def depositing(w: dict, screw: bool = False) -> np.ndarray:
@@ -40,6 +41,34 @@ def depositing(w: dict, screw: bool = False) -> np.ndarray:
     welding = (np.asarray(w["laser"]) == 1) & feeding if "laser" in w else False
     turning = (np.asarray(w["spindle"]) > 0) & feeding if screw else False
     return moving & ((np.asarray(w["de"]) > 0) | welding | turning)
+
+
+def laser_power(w: dict) -> np.ndarray:
+    """Beam power of each waypoint on a laser in GRBL's laser mode, in S units (full power at ``$30``).
+
+    The programmed S while M3 or M4 is on, on feed moves (G1-G3) only: G0
+    moves with the beam off.  Under M3 the power is constant; under M4
+    (dynamic, the spindle column negative) GRBL scales it with the actual
+    speed over the programmed one, here the move's average: length over
+    planned time against its feed.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> w = {"motion": np.array([1, 2, 2, 2]), "spindle": np.array([0.0, 255.0, -255.0, 0.0]),
+    ...      "distance": np.array([5.0, 10.0, 10.0, 10.0]), "time": np.array([0.1, 1.0, 2.0, 1.0]),
+    ...      "feed": np.array([600.0, 600.0, 600.0, 600.0])}
+    >>> laser_power(w).tolist()  # rapid unlit, M3 full S, M4 at half the programmed speed, beam off
+    [0.0, 255.0, 127.5, 0.0]
+    """
+    spindle = np.asarray(w["spindle"], float)
+    burning = (np.asarray(w["motion"]) >= 2) & (spindle != 0)
+    distance, time = np.asarray(w["distance"], float), np.asarray(w["time"], float)
+    programmed = np.asarray(w["feed"], float) / 60.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.clip(np.where((time > 0) & (programmed > 0), distance / time / programmed, 1.0), 0.0, 1.0)
+    dynamic = np.where(spindle < 0, np.nan_to_num(ratio, nan=1.0), 1.0)
+    return np.where(burning, np.abs(spindle) * dynamic, 0.0)
 
 
 def screw_extruder(op: "Operation") -> bool:

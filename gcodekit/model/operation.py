@@ -312,8 +312,8 @@ class Operation:
         """One row per waypoint: command columns then process columns.
 
         Columns: ``line``, ``command`` (row in ``commands``), ``code``,
-        ``kind``, then the waypoint columns (see :data:`gcodekit.schema.WAYPOINT_COLUMNS`) and
-        ``elapsed_time``.  Before emulation, one row per command with only
+        ``kind``, then the waypoint columns (see :data:`gcodekit.schema.WAYPOINT_COLUMNS`),
+        ``elapsed_time`` and the other derived columns (``power`` on laser machines).  Before emulation, one row per command with only
         the command columns and the parameters.
         """
         import pandas as pd
@@ -338,6 +338,8 @@ class Operation:
         data["elapsed_time"] = self.elapsed_time()
         data["start_time"] = data["elapsed_time"] - np.nan_to_num(np.asarray(w["time"], float))
         data["layer"], data["feature"], data["depositing"] = self.layers, self.features, self.depositing
+        if "power" in w:  # laser machines
+            data["power"] = w["power"]
         return pd.DataFrame(data, copy=False)
 
     def _codes(self) -> np.ndarray:

@@ -28,6 +28,7 @@ from ..errors import ConfigError, Diagnostics, GcodeError, check_choice
 from ..limits import MAX_ITERATIONS, MAX_MOTIONS, Limits
 from ..memory import release_freed_memory
 from ..model import OPERATION_CLASSES, Operation
+from ..model.derived import laser_power
 from ..parse import CommandTable, GcodeParser
 from ..plan import machine_options as firmware_options
 from ..plan import planner_settings, run_planner
@@ -134,6 +135,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         op.diagnostics = diagnostics
     if plan and config.planner:
         run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
+    if config.laser and op.waypoints is not None:
+        op.waypoints["power"] = laser_power(op.waypoints)
     restore_line_numbers(op.table, diagnostics)
     quote_diagnostics(op.diagnostics, program)
     return op
