@@ -118,6 +118,20 @@ class GrblConfig:
         return cls(**values)
 
 
+def machine_options(path: str | os.PathLike) -> dict[str, bool]:
+    """What the emulator needs from a ``$$`` dump: ``$32`` (laser mode) makes the machine a laser.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "laser.txt"
+    >>> _ = p.write_text("$30=1000\n$32=1\n$110=6000\n")
+    >>> machine_options(p)
+    {'laser': True}
+    """
+    return {"laser": GrblConfig.from_settings(path).laser_mode}
+
+
 def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray, arc_tolerance: float) -> np.ndarray:
     """Chords per arc as grbl's ``mc_arc`` cuts them.
 
