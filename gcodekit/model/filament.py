@@ -96,3 +96,59 @@ def filament_used(op: "Operation", convention: str | None = None) -> float:
     drawn = np.cumsum(e)
     before = float(np.max(drawn[:start], initial=0.0))
     return float(max(np.max(drawn[start:], initial=0.0), before) - before)
+
+
+#: How slicers state the filament diameter in their header or settings block (the first group is it, mm):
+#: Slic3r/PrusaSlicer/OrcaSlicer/Bambu Studio, KISSlicer, Cura's Griffin header, Simplify3D.
+_STATED_DIAMETER = re.compile(
+    r"(?im)^;\s*(?:filament_diameter\s*=|fiber_dia_mm\s*=|EXTRUDER_TRAIN\.0\.MATERIAL\.DIAMETER:|"
+    r"filamentDiameters?\s*,|Filament Diameter(?:\s*#\d+)?\s*:)\s*([0-9]*\.?[0-9]+)")
+
+
+def stated_diameter(text: str) -> float | None:
+    """The filament diameter a program's header or settings block states, mm; None when it states none.
+
+    The first one found counts (the first extruder's); values outside 1-4 mm are no filament diameter.
+
+    Examples
+    --------
+    >>> stated_diameter("; KISSlicer - FREE\\n; fiber_dia_mm = 3\\nG1 X1 E1\\n")
+    3.0
+    >>> stated_diameter("; filament_diameter = 2.85,1.75\\n"), stated_diameter("G1 X1\\n")
+    (2.85, None)
+    """
+    for match in _STATED_DIAMETER.finditer(text):
+        value = float(match[1])
+        if 1.0 <= value <= 4.0:
+            return value
+    return None
+
+
+#: A program whose E words fall on this share of its extruding moves writes them relative.
+RELATIVE_SHARE = 0.3
+
+
+def relative_e_suspect(op: "Operation") -> tuple[int, int, int] | None:
+    """``(line, falling, extruding)`` when the E words read as absolute fall on many moves with XY motion.
+
+    A slicer that writes E relative (KISSlicer does, per move) without an
+    M83 leaves a firmware in absolute E, where each E is a position: the
+    filament then runs back and forth and sums to about nothing.  Absolute E
+    falls on a printing move only where a slicer wipes while retracting, a
+    small share; at :data:`RELATIVE_SHARE` or more of at least 20 extruding
+    moves this returns the first such move's source line and the counts.
+    None when the program sets the E mode itself (M82/M83) or looks absolute.
+    """
+    from ..parse.table import NAME_ID
+
+    t, w = op.table, op.waypoints
+    if np.isin(t.name, [NAME_ID["extrude_absolute"], NAME_ID["extrude_relative"]]).any():
+        return None
+    de = programmed_e(w)
+    moving = (np.asarray(w["motion"]) >= 2) & (np.asarray(w["distance"]) > 0) & (de != 0)
+    falling = moving & (de < 0)
+    n, k = int(moving.sum()), int(falling.sum())
+    if n < 20 or k < RELATIVE_SHARE * n:
+        return None
+    rows = w["command"] if "command" in w else np.arange(len(t))
+    return int(t.line[rows[int(np.flatnonzero(falling)[0])]]), k, n

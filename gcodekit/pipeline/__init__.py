@@ -29,6 +29,7 @@ from ..limits import MAX_ITERATIONS, MAX_MOTIONS, Limits
 from ..memory import release_freed_memory
 from ..model import OPERATION_CLASSES, Operation
 from ..model.derived import laser_power
+from ..model.filament import relative_e_suspect, stated_diameter
 from ..parse import CommandTable, GcodeParser
 from ..plan import machine_options as firmware_options
 from ..plan import planner_settings, run_planner
@@ -54,6 +55,8 @@ def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None,
     fl, config, detection = resolve(program, None, flavor)
     diagnostics = Diagnostics(program.name, mode)
     note_weak_detection(detection, diagnostics)
+    if config.process == "additive" and machine_config is None and "filament_diameter" not in machine_options:
+        config = _stated_filament(program, config, diagnostics)
     parser = GcodeParser(fl, diagnostics)
     parts, n_lines = [], 0
     for blocks, lines in program_blocks(program, fl, diagnostics):
@@ -126,6 +129,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         config = dataclasses.replace(config, **firmware_options(config.planner, machine_config))
     diagnostics = Diagnostics(program.name, mode)
     note_weak_detection(detection, diagnostics)
+    if config.process == "additive" and machine_config is None and "filament_diameter" not in machine_options:
+        config = _stated_filament(program, config, diagnostics)
     op, reading_error, machine_run = _emulated(program, fl, config, diagnostics, limits, progress)
     if uses_compensation(op):
         compensate(op, machine_run.tools, machine_run.comp_profile_ends)
@@ -137,9 +142,33 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
     if config.laser and op.waypoints is not None:
         op.waypoints["power"] = laser_power(op.waypoints)
+    if config.process == "additive" and config.extruder_type == "filament" and op.waypoints is not None:
+        _note_relative_e(op, fl)
     restore_line_numbers(op.table, diagnostics)
     quote_diagnostics(op.diagnostics, program)
     return op
+
+
+def _stated_filament(program: Program, config: MachineConfig, diagnostics: Diagnostics) -> MachineConfig:
+    """The machine with the filament diameter the program's header or settings block states, said once."""
+    stated = stated_diameter(program.head() + "\n" + program.tail())
+    if stated is None or stated == config.filament_diameter:
+        return config
+    diagnostics.report(1, 1, f"filament diameter {stated:g} mm, as the program states (the {config.name} machine "
+                       f"preset says {config.filament_diameter:g} mm); give filament_diameter= to choose otherwise",
+                       severity="info")
+    return dataclasses.replace(config, filament_diameter=stated)
+
+
+def _note_relative_e(op: Operation, fl: Flavor) -> None:
+    """A warning when E words written relative run as absolute positions (no M83: KISSlicer's files)."""
+    suspect = relative_e_suspect(op)
+    if suspect is not None and fl.extrusion == "absolute":
+        line, falling, moving = suspect
+        op.diagnostics.warn(line, 1, f"E falls on {falling} of {moving} extruding moves: the E words look relative "
+                            "(as KISSlicer writes them), but the program never selects relative E (M83) and this "
+                            f"firmware reads them as absolute positions, so the filament runs back and forth; "
+                            "add M83 after the program's G90 if they are relative")
 
 
 def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits,

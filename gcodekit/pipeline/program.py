@@ -49,6 +49,18 @@ class Program:
         return ""
 
 
+    def tail(self, size: int = 65536) -> str:
+        """The end of a plain program file or text ('' for a compressed file): where slicers put their settings."""
+        if self.text is not None:
+            return self.text[-size:]
+        with open(self.path, "rb") as f:
+            if f.read(6).startswith((b"\x1f\x8b", b"BZh", b"\xfd7zXZ")):
+                return ""
+            f.seek(0, os.SEEK_END)
+            f.seek(max(f.tell() - size, 0))
+            return f.read().decode("utf-8", "replace")
+
+
 def as_program(source: str | os.PathLike) -> Program:
     """A path names a file; a string with a newline, or no such file, is program text."""
     if isinstance(source, os.PathLike):
