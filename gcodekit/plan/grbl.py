@@ -125,7 +125,7 @@ def machine_options(path: str | os.PathLike) -> dict[str, bool]:
     --------
     >>> import tempfile, pathlib
     >>> p = pathlib.Path(tempfile.mkdtemp()) / "laser.txt"
-    >>> _ = p.write_text("$30=1000\n$32=1\n$110=6000\n")
+    >>> _ = p.write_text("$30=1000\\n$32=1\\n$110=6000\\n")
     >>> machine_options(p)
     {'laser': True}
     """
