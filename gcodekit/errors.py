@@ -102,15 +102,23 @@ class Diagnostics:
     limit : int, default: 10000
         Lenient mode keeps at most this many diagnostics (then counts the rest),
         so a binary file cannot make the list unbounded.
+    repeats : int, default: 20
+        One message (same severity and words) is listed this many times; the
+        rest are counted into one summary diagnostic at the first unlisted
+        line, so one kind of unreadable text (a dialect's comments read as
+        words) says so once rather than thousands of times.
     """
 
-    def __init__(self, file: str = "<string>", mode: str = "lenient", limit: int = 10_000):
+    def __init__(self, file: str = "<string>", mode: str = "lenient", limit: int = 10_000, repeats: int = 20):
         self.file = file
         self.mode = check_choice("mode", mode, MODES)
         self.limit = limit
+        self.repeats = repeats
         self.items: list[Diagnostic] = []
         self._kinds: list[str] = []  # of each item: which GcodeError it raises as
-        self.dropped = 0
+        self.dropped = 0  # not listed: beyond the limit, or repeats counted in a summary
+        self._seen: dict[tuple[str, str], int] = {}  # (severity, message) -> times reported
+        self._summary_at: dict[tuple[str, str], int] = {}  # -> index of its summary in items
         #: Line numbers standing for lines of other files (subroutine files): number -> (file, line)
         self.elsewhere: dict[int, tuple[str, int]] = {}
         self._first_error: tuple[str, Diagnostic] | None = None  # (kind, diagnostic), for raise_first
@@ -139,12 +147,31 @@ class Diagnostics:
             raise _ERROR_TYPES[kind](message, diag)
         if severity == "error" and self._first_error is None:
             self._first_error = (kind, diag)
+        key = (severity, message)
+        seen = self._seen[key] = self._seen.get(key, 0) + 1
+        if seen > self.repeats:
+            self._summarise(key, diag, kind, seen - self.repeats)
+            return diag
         if len(self.items) < self.limit:
             self.items.append(diag)
             self._kinds.append(kind)
         else:
             self.dropped += 1
         return diag
+
+    def _summarise(self, key: tuple[str, str], diag: Diagnostic, kind: str, more: int) -> None:
+        """Count a repeat of a listed message into its one summary diagnostic (made at the first repeat)."""
+        self.dropped += 1
+        at = self._summary_at.get(key)
+        if at is None:
+            if len(self.items) >= self.limit:
+                return
+            self._summary_at[key] = at = len(self.items)
+            self.items.append(diag)
+            self._kinds.append(kind)
+        first = self.items[at]
+        self.items[at] = Diagnostic(first.file, first.line, first.column, first.severity,
+                                    f"{key[1]} -- and {more} more times from this line on, not listed", first.text)
 
     def warn(self, line: int, column: int, message: str, text: str = "") -> Diagnostic:
         return self.report(line, column, message, text, severity="warning")

@@ -42,6 +42,8 @@ MIN_SCORE = 3.0
 STRONG_SCORE = 10.0
 #: Candidates within this many points of the winner are reported as close.
 CLOSE_POINTS = 1.0
+#: With fewer moves than this in the head and nothing else to go by, the file extension picks the default.
+FEW_MOVES = 10
 
 _COMMENTS = re.compile(r"\([^()\n]*\)|;[^\n]*")
 _GM_CODE = re.compile(r"(?<![A-Za-z_#<])([GgMm])[ \t]*0*(\d+(?:\.\d+)?)")
@@ -51,6 +53,7 @@ _NAME = re.compile(r"^[ \t]*([A-Za-z_]{2}\w*)", re.M)
 # backtracks over every pair of positions: minutes on one long line)
 _MOVE_CODE = re.compile(r"\b[Gg]0*[0-3]\b")
 _E_AFTER = re.compile(r"[ \t][Ee][-+]?\.?\d")
+_MOVE_LINE = re.compile(r"(?im)^[ \t]*(?:N\d+[ \t]*)?G0*[0-3](?![\d.])")
 
 
 @dataclass(frozen=True)
@@ -140,6 +143,7 @@ class _Evidence:
     style: str  # the comment style most lines use
     suffix: str
     e_words: bool = False  # E words on moves (see _e_words_on_moves)
+    moves: int = 0  # lines with a G0-G3 in the head
 
 
 def _e_words_on_moves(bare: str) -> bool:
@@ -202,8 +206,9 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     comment style.  The best score wins; equal
     scores go to the higher ``priority``.  Below 3 points the evidence is
     too thin and a default is used: ``"marlin"`` for programs with E words
-    on moves and without parenthesised comments, ``"rs274ngc"`` (the
-    reference language) otherwise.  The choice is ``weak`` below 10 points
+    on moves and without parenthesised comments, the flavor the file
+    extension names when the head holds fewer than 10 moves (an empty
+    ``.gcode`` file), ``"rs274ngc"`` (the reference language) otherwise.  The choice is ``weak`` below 10 points
     or with a candidate on other headers within a point of the winner.
 
     Parameters
@@ -236,7 +241,7 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     bare = _COMMENTS.sub("", head)
     evidence = _Evidence(head, bare, _codes_in(head), _comment_style(lines),
                          os.path.splitext(os.fspath(filename))[1].lower() if filename is not None else "",
-                         _e_words_on_moves(bare))
+                         _e_words_on_moves(bare), len(_MOVE_LINE.findall(bare)))
     e_words, style = evidence.e_words, evidence.style
     scored = []
     for rules in _all_rules():
@@ -247,8 +252,13 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     candidates = tuple((name, score) for score, _, name, _ in scored if score > 0)
     best_score, _, best, reasons = scored[0]
     if best_score < MIN_SCORE:
-        default = "marlin" if e_words and style != "(" else "rs274ngc"
-        why = "E words on moves" if default == "marlin" else "the reference language"
+        by_name = _extension_default(evidence.suffix) if evidence.moves < FEW_MOVES else None
+        if e_words and style != "(":
+            default, why = "marlin", "E words on moves"
+        elif by_name is not None:
+            default, why = by_name, f"file extension {evidence.suffix}, with too few moves to tell"
+        else:
+            default, why = "rs274ngc", "the reference language"
         return Detection(
             default,
             0.0,
@@ -265,6 +275,15 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     headers = {name: {r for r in why if r.startswith("header")} for _, _, name, why in scored}
     rival = any(headers[name] != headers[best] for name, _ in close)
     return Detection(best, best_score, tuple(reasons), candidates, weak=rival or best_score < STRONG_SCORE)
+
+
+def _extension_default(suffix: str) -> str | None:
+    """The flavor a file name suggests when nothing else does: its own extension first, then a shared one."""
+    for field in ("extensions", "shared_extensions"):
+        claims = [r for r in _all_rules() if suffix and suffix in getattr(r, field)]
+        if claims:
+            return max(claims, key=lambda r: (r.priority, r.name)).name
+    return None
 
 
 def guess_flavor(text_head: str, filename: str | os.PathLike[str] | None = None) -> Flavor:
