@@ -55,8 +55,6 @@ def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None,
     fl, config, detection = resolve(program, None, flavor)
     diagnostics = Diagnostics(program.name, mode)
     note_weak_detection(detection, diagnostics)
-    if config.process == "additive" and machine_config is None and "filament_diameter" not in machine_options:
-        config = _stated_filament(program, config, diagnostics)
     parser = GcodeParser(fl, diagnostics)
     parts, n_lines = [], 0
     for blocks, lines in program_blocks(program, fl, diagnostics):

@@ -53,7 +53,8 @@ _NAME = re.compile(r"^[ \t]*([A-Za-z_]{2}\w*)", re.M)
 # backtracks over every pair of positions: minutes on one long line)
 _MOVE_CODE = re.compile(r"\b[Gg]0*[0-3]\b")
 _E_AFTER = re.compile(r"[ \t][Ee][-+]?\.?\d")
-_MOVE_LINE = re.compile(r"(?im)^[ \t]*(?:N\d+[ \t]*)?G0*[0-3](?![\d.])")
+# A move line: G0-G3, or an axis word opening the line (the motion mode in force moves it)
+_MOVE_LINE = re.compile(r"(?im)^[ \t]*(?:N\d+[ \t]*)?(?:G0*[0-3](?![\d.])|[XYZ][ \t]*[-+.\d])")
 
 
 @dataclass(frozen=True)
@@ -143,7 +144,7 @@ class _Evidence:
     style: str  # the comment style most lines use
     suffix: str
     e_words: bool = False  # E words on moves (see _e_words_on_moves)
-    moves: int = 0  # lines with a G0-G3 in the head
+    moves: int = 0  # move lines in the head (see _MOVE_LINE)
 
 
 def _e_words_on_moves(bare: str) -> bool:
@@ -252,7 +253,8 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     candidates = tuple((name, score) for score, _, name, _ in scored if score > 0)
     best_score, _, best, reasons = scored[0]
     if best_score < MIN_SCORE:
-        by_name = _extension_default(evidence.suffix) if evidence.moves < FEW_MOVES else None
+        unread = {name for score, _, name, _ in scored if score < 0}  # text the flavor cannot read
+        by_name = _extension_default(evidence.suffix, unread) if evidence.moves < FEW_MOVES else None
         if e_words and style != "(":
             default, why = "marlin", "E words on moves"
         elif by_name is not None:
@@ -274,13 +276,17 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     # a close candidate on the same headers is a relative (Klipper's banners are Marlin's): no doubt there
     headers = {name: {r for r in why if r.startswith("header")} for _, _, name, why in scored}
     rival = any(headers[name] != headers[best] for name, _ in close)
-    return Detection(best, best_score, tuple(reasons), candidates, weak=rival or best_score < STRONG_SCORE)
+    # the dialect's own extension (.ngc) does not decide, but it confirms what the content chose
+    confirmed = any(r.name == best and evidence.suffix in r.extensions for r in _all_rules())
+    return Detection(best, best_score, tuple(reasons), candidates,
+                     weak=rival or (best_score < STRONG_SCORE and not confirmed))
 
 
-def _extension_default(suffix: str) -> str | None:
-    """The flavor a file name suggests when nothing else does: its own extension first, then a shared one."""
+def _extension_default(suffix: str, unread: set[str]) -> str | None:
+    """The flavor a file name suggests when nothing else does: its own extension first, then a shared one
+    (never one in ``unread``, whose ``against`` rules matched)."""
     for field in ("extensions", "shared_extensions"):
-        claims = [r for r in _all_rules() if suffix and suffix in getattr(r, field)]
+        claims = [r for r in _all_rules() if suffix and suffix in getattr(r, field) and r.name not in unread]
         if claims:
             return max(claims, key=lambda r: (r.priority, r.name)).name
     return None
