@@ -223,19 +223,11 @@ def test_laser_power_is_a_column_and_a_colouring(read_all):
 
 # -- small programs of our own in the tools' styles ------------------------------------------------------
 
-# A plasma cutting script written as .gcode (torch on M3, pierce delay in a comment's words)
-PLASMA = """(Plasma: 100 mm square, pierce and cut)
-G21
-G90
-G0 X0 Y0
-M3 (torch on)
-G4 P0.5 (pause to finish the pierce)
-G1 X100 F1000
-G1 Y100
-M5 (torch off)
-G0 X0 Y0
-M30
-"""
+# A plasma cutting script written as .gcode: the feed set once, the torch on M3, a pierce delay whose
+# comment has words (read as Marlin, the 'f' of 'finish' was a bare F that cleared the feed)
+SQUARE = "M3 (torch on)\nG4 P0.5 (pause to finish the pierce)\nG1 X{x1}\nG1 Y100\nG1 X{x0}\nG1 Y0\nM5 (torch off)\n"
+PLASMA = ("(Plasma: two 100 mm squares)\nG21\nG90\nF1000\nG0 X0 Y0\n" + SQUARE.format(x0=0, x1=100)
+          + "G0 X150 Y0\n" + SQUARE.format(x0=150, x1=250) + "G0 X0 Y0\nM30\n")
 
 
 def test_plasma_program_named_gcode_is_a_mill_program(tmp_path):
@@ -246,10 +238,10 @@ def test_plasma_program_named_gcode_is_a_mill_program(tmp_path):
         assert op.flavor.name == "rs274ngc" and op.machine.process == "subtractive"
         assert [d.severity for d in op.diagnostics.items] == ["info"]  # thin evidence, said so
         w = op.waypoints
-        # 100 mm at 1000 mm/min twice: 12 s of cutting, plus the 0.5 s pierce dwell; the 'f' of 'finish'
-        # in a comment is no F word
-        assert float(np.nansum(w["time"][w["motion"] >= 2])) == pytest.approx(12.0)
-        assert float(np.nansum(w["time"][w["motion"] == 0])) == pytest.approx(0.5)
+        # two squares of 400 mm at 1000 mm/min: 48 s of cutting, plus two 0.5 s pierce dwells
+        assert float(np.nansum(w["time"][w["motion"] >= 2])) == pytest.approx(48.0)
+        assert float(np.nansum(w["time"][w["motion"] == 0])) == pytest.approx(1.0)
+        assert op.summary()["untimed_moves"] == 0
 
 
 FUSION_STYLE = """(1001)
