@@ -204,13 +204,15 @@ def detect_flavor(text_head: str, filename: str | os.PathLike[str] | None = None
     other dialects (``.nc``, ``.tap``) -- the name alone never decides --,
     3 for each ``hints`` regex found in the code, 2 for E words on moves if
     the flavor extrudes, 1 for each typical code present and 1 for the usual
-    comment style.  The best score wins; equal
-    scores go to the higher ``priority``.  Below 3 points the evidence is
-    too thin and a default is used: ``"marlin"`` for programs with E words
-    on moves and without parenthesised comments, the flavor the file
-    extension names when the head holds fewer than 10 moves (an empty
-    ``.gcode`` file), ``"rs274ngc"`` (the reference language) otherwise.  The choice is ``weak`` below 10 points
-    or with a candidate on other headers within a point of the winner.
+    comment style.  The best score wins; equal scores go to the higher
+    ``priority``.  Below 3 points the evidence is too thin and a default is
+    used: ``"marlin"`` for programs with E words on moves and without
+    parenthesised comments, the flavor the file extension names when the
+    head holds fewer than 10 moves (an empty ``.gcode`` file),
+    ``"rs274ngc"`` (the reference language) otherwise.  The choice is
+    ``weak`` below 10 points (unless the file has the winner's own
+    extension, which confirms it) or with a candidate on other headers
+    within a point of the winner.
 
     Parameters
     ----------
