@@ -87,11 +87,11 @@ class DetectRules:
     codes : tuple of str
         Codes typical of the dialect (``M82``, ``SET_VELOCITY_LIMIT``).
     extensions : tuple of str
-        File suffixes of the dialect (``.ngc``, and its relatives': Marlin's
-        ``.gcode`` for Klipper): strong evidence.
+        File suffixes of the dialect's own (``.ngc``): weak evidence that
+        tips an even balance and confirms what the content chose.
     shared_extensions : tuple of str
-        File suffixes it shares with unrelated dialects (``.nc``, ``.tap``):
-        a hint only.
+        File suffixes it shares with unrelated dialects (``.nc``, ``.tap``,
+        ``.gcode``): a hint only.
     comment : str
         The comment style the dialect mostly uses: ``";"``, ``"("`` or ``""``.
     priority : int
