@@ -39,7 +39,10 @@ class UsageError(ValueError):
 
 
 def _parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     p = argparse.ArgumentParser(prog="gcodekit", description="Read, emulate and summarise G-code programs.")
+    p.add_argument("--version", action="version", version=f"gcodekit {__version__}")
     debug = argparse.ArgumentParser(add_help=False)
     debug.add_argument("--debug", action="store_true",
                        help="on an internal error, print the traceback (for a bug report)")
