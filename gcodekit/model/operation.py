@@ -61,6 +61,8 @@ class Operation:
     """
 
     process_data_class: type[ProcessData] = ProcessData
+    #: The kind of process, as machine presets name it: ``"additive"``, ``"subtractive"`` or ``"generic"``.
+    process: str = "generic"
 
     def __init__(self, commands: CommandTable, waypoints: dict[str, np.ndarray] | None = None, *,
                  file: str = "<string>", flavor: "Flavor | None" = None,
@@ -94,6 +96,21 @@ class Operation:
         if name not in self._derived:
             self._derived[name] = make()
         return self._derived[name]
+
+    @property
+    def moving(self) -> np.ndarray:
+        """Per waypoint, whether it moves the tool (a motion of some length; see :mod:`gcodekit.model.derived`)."""
+        return self._kept("moving", lambda: derived.moving(self.waypoints))
+
+    @property
+    def work(self) -> np.ndarray:
+        """Per waypoint, whether the move does the process's work: what pictures draw as the part.
+
+        Feed moves (G1-G3 and the like) of some length here; an additive
+        operation's depositing moves from the first layer on.  The other
+        moves are travel.
+        """
+        return self._kept("work", lambda: self.moving & (np.asarray(self.waypoints["motion"]) >= 2))
 
     @property
     def depositing(self) -> np.ndarray:
@@ -240,9 +257,14 @@ class Operation:
         """
         if not self._require_emulation("get_bounds()"):
             return None
+        from ..errors import check_choice
         from .bounds import toolpath_bounds
 
-        return toolpath_bounds(self.waypoints, which)
+        check_choice("which", which, ("motion", "feed", "extrude"))
+        motion = np.asarray(self.waypoints["motion"])
+        selected = {"motion": motion > 0, "feed": motion >= 2, "extrude": self.depositing}[which]
+        # a cut or a bead starts where the previous step ended
+        return toolpath_bounds(self.waypoints, selected, with_starts=which != "motion")
 
     def get_statistics(self) -> dict[str, Any] | None:
         """Counts, distances, time and (additive) layers and filament.
@@ -287,20 +309,24 @@ class Operation:
 
         return plot_operation(self, scalars, **options)
 
-    def to_vtk(self, path: str | os.PathLike | None = None, **options):
-        """The deposition paths as a PyVista mesh, written to ``path`` (``.vtp``/``.vtk``) when given.
+    def volumes(self) -> np.ndarray:
+        """Material each waypoint moves, mm^3: laid (additive) or removed (subtractive); NaN where unknown."""
+        return np.full(len(self.waypoints["x"]), np.nan)
 
-        Builds an :class:`~gcodekit.additive.AdditivePart` (``options`` such as
-        ``bead=`` and ``layer_normal=`` go to it) and exports it with
-        :class:`~gcodekit.export.vtk.VTKExporter`.
+    def to_vtk(self, path: str | os.PathLike | None = None, **options):
+        """The toolpath as a PyVista mesh of poly-lines, written to ``path`` (``.vtp``/``.vtk``) when given.
+
+        See :meth:`gcodekit.export.vtk.VTKExporter.toolpath_to_polydata` for
+        the cells and their data (feed, speed, tool, source line, tool
+        direction); an additive operation writes its deposition paths instead.
         """
-        from ..additive import AdditivePart
         from ..export.vtk import VTKExporter
 
-        part = AdditivePart(self, **options)
+        if options:
+            raise TypeError(f"to_vtk() of a {self.process} operation takes no options, not {', '.join(options)}")
         if path is not None:
-            VTKExporter.additive_part_to_vtk(part, path)
-        return VTKExporter.additive_part_to_polydata(part)
+            VTKExporter.toolpath_to_vtk(self, path)
+        return VTKExporter.toolpath_to_polydata(self)
 
     def to_gcode(self, flavor: str = "rs274ngc") -> str:
         """The commands written back as G-code of ``flavor`` (see :class:`gcodekit.export.gcode.GcodeExporter`)."""
