@@ -34,7 +34,7 @@ EXPORT_FORMATS = ("csv", "parquet", "vtk", "events")
 _DEFAULT_SUFFIX = {"csv": None, "events": None, "parquet": ".parquet", "vtk": ".vtp"}
 
 
-class UsageError(ValueError):
+class UsageError(ConfigError):
     """A command-line argument that cannot work (exit status 2)."""
 
 

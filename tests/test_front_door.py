@@ -44,13 +44,24 @@ def test_new_waypoints_forget_the_old_derived_columns():
 def test_columns_document_every_dataframe_column(cube):
     frame = cube.to_dataframe()
     schema = cube.columns
-    documented = [c for c in frame.columns if c in COLUMNS]
-    assert set(schema.index) >= set(documented) and set(documented) >= set(schema.index) - {"accel"}
+    assert set(frame.columns) <= set(COLUMNS), set(frame.columns) - set(COLUMNS)  # every column is in the schema
+    assert set(schema.index) >= set(frame.columns) >= set(schema.index) - {"accel"}
     assert schema.loc["x", "unit"] == "mm" and schema.loc["elapsed_time", "unit"] == "s"
-    for name in documented:
-        if name in ("motion", "feature"):
-            continue  # categorical / object in the frame
+    for name in frame.columns:
+        if name == "motion":
+            continue  # the waypoints' uint8 code, a categorical of its names in the frame
         assert str(frame[name].dtype) == schema.loc[name, "dtype"], name
+
+
+@pytest.mark.parametrize("program, machine", [("bracket_mill.ngc", None), ("dome_ded_beckhoff.nc", None),
+                                              ("cead_wall.mpf", None), ("baam_wall.nc", None)])
+def test_every_column_a_stage_makes_is_in_the_schema(program, machine):
+    op = gcodekit.gcode_to_operation(EXAMPLES / program, machine)
+    for name, values in op.waypoints.items():
+        assert name in COLUMNS, name
+        assert values.dtype == np.dtype(COLUMNS[name].dtype), name
+    frame = op.to_dataframe()
+    assert set(frame.columns) <= set(COLUMNS), set(frame.columns) - set(COLUMNS)
 
 
 def test_the_one_summary_record_is_what_info_prints(cube, capsys):

@@ -203,7 +203,7 @@ class VTKExporter:
         mesh = pv.PolyData(points, lines=cells)
         distance = np.asarray(w["distance"], float)[moves]
         time = np.nan_to_num(np.asarray(w["time"], float))[moves]
-        rows = w["command"] if "command" in w else np.arange(len(w["x"]))
+        rows = w["command"]
         line = np.asarray(op.table.line)[rows]
         mesh.cell_data["rapid"] = rapid[first]
         mesh.cell_data["tool"] = tool[first]

@@ -59,7 +59,7 @@ def depositing_of(op: "Operation") -> np.ndarray:
 def waypoint_rows(op: "Operation") -> np.ndarray:
     """The command row of each waypoint."""
     w = op.waypoints
-    return w["command"] if "command" in w else np.arange(len(op.table))
+    return w["command"]
 
 
 def row_labels(op: "Operation", pattern: str) -> tuple[np.ndarray, list[str]]:

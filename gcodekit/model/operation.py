@@ -37,6 +37,8 @@ if TYPE_CHECKING:
     import pandas as pd
 
     from ..emulate.presets import MachineConfig
+    from ..plan import Plan
+    from ..plan.moves import PlannedMoves, PlanResult
     from ..syntax import Flavor
 
 
@@ -77,8 +79,7 @@ class Operation:
         self.machine = machine
         self.diagnostics = diagnostics if diagnostics is not None else Diagnostics(file)
         self.n_lines = n_lines
-        self._elapsed: np.ndarray | None = None
-        self.plan = None  # (PlannedMoves, PlanResult) once a motion planner has run
+        self.plan: tuple[PlannedMoves, PlanResult] | None = None  # once a motion planner has run
 
     @property
     def waypoints(self) -> dict[str, np.ndarray] | None:
@@ -187,7 +188,7 @@ class Operation:
         columns = self._process_columns()
 
         def make(i: int) -> ProcessData:
-            k = i if mapping is None else int(mapping[i])
+            k = int(mapping[i])
             return self.process_data_class(**self._process_fields(k, columns))
 
         return LazyList(len(self.table), make)
@@ -203,11 +204,9 @@ class Operation:
         state = "emulated" if self.emulated else "not emulated"
         return f"<{type(self).__name__} {self.file!r}: {len(self)} commands, {state}>"
 
-    def _waypoint_of_command(self) -> np.ndarray | None:
-        """Index of each command's own (last) waypoint, or None when one each."""
-        cmd = self.waypoints.get("command") if self.waypoints else None
-        if cmd is None:
-            return None
+    def _waypoint_of_command(self) -> np.ndarray:
+        """Index of each command's own (last) waypoint."""
+        cmd = self.waypoints["command"]
         last = np.r_[cmd[1:] != cmd[:-1], True]
         return np.flatnonzero(last)
 
@@ -228,9 +227,13 @@ class Operation:
 
     def elapsed_time(self) -> np.ndarray:
         """Time at the end of each waypoint, s (NaN steps count as zero)."""
-        if self._elapsed is None:
-            self._elapsed = np.cumsum(np.nan_to_num(self.waypoints["time"]))
-        return self._elapsed
+        return self._kept("elapsed_time", lambda: np.cumsum(np.nan_to_num(self.waypoints["time"])))
+
+    def attach_plan(self, plan: "Plan") -> None:
+        """Take a motion planner's result: its per-waypoint ``time`` and, as :attr:`plan`, the per-move plan."""
+        self.waypoints["time"] = plan.time
+        self.plan = (plan.moves, plan.result)
+        self._derived.pop("elapsed_time", None)
 
     # -- summaries ----------------------------------------------------------------
 
@@ -351,8 +354,7 @@ class Operation:
                 frame[letter] = t.param(letter)
             return frame
         w = self.waypoints
-        cmd = w.get("command")
-        rows = np.arange(len(t)) if cmd is None else cmd
+        rows = w["command"]
         data = {"line": t.line[rows], "command": rows, "code": self._codes()[rows], "kind": self._kinds()[rows]}
         for column in WAYPOINT_COLUMNS:
             data[column.name] = w[column.name]
@@ -360,7 +362,7 @@ class Operation:
         if getattr(self, "plan", None) is not None:
             from ..plan import waypoint_speeds
 
-            data.update(waypoint_speeds(self))
+            data.update(waypoint_speeds(self.plan, len(w["x"])))
         data["elapsed_time"] = self.elapsed_time()
         data["start_time"] = data["elapsed_time"] - np.nan_to_num(np.asarray(w["time"], float))
         data["layer"], data["feature"], data["depositing"] = self.layers, self.features, self.depositing
@@ -406,8 +408,7 @@ class Operation:
             return pd.DataFrame()
         w = self.waypoints
         moved = np.flatnonzero(w["motion"] > 0)
-        cmd = w.get("command")
-        rows = moved if cmd is None else cmd[moved]
+        rows = w["command"][moved]
         inch = w["units"][moved] == 1
         scale = np.where(inch, 1.0 / MM_PER_INCH, 1.0)
         frame = {"line": self.table.line[rows],
@@ -427,7 +428,7 @@ class Operation:
         if getattr(self, "plan", None) is not None:  # planned by the machine's firmware model
             from ..plan import waypoint_speeds
 
-            for key, values in waypoint_speeds(self).items():
+            for key, values in waypoint_speeds(self.plan, len(w["x"])).items():
                 if key != "accel":
                     frame[key] = values[moved] * scale
         return pd.DataFrame(frame)

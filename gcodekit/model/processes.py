@@ -106,7 +106,7 @@ class AdditiveOperation(Operation):
         [16.0, 16.0]
         """
         w = self.waypoints
-        rows = np.asarray(w["command"]) if "command" in w else np.arange(len(w["x"]))
+        rows = np.asarray(w["command"])
         n = len(self.table)
         calls = np.flatnonzero(np.asarray(self.table.name) == NAME_ID["set_bead"]) if n else np.zeros(0, int)
         area_of_row = np.full(n, np.nan)
