@@ -225,3 +225,15 @@ def test_every_error_is_rooted_in_gcode_error():
                 wrong.append(f"{qualified} derives from {', '.join(b.__name__ for b in cls.__bases__)}")
     assert not wrong, "errors users can meet must derive from GcodeError:\n" + "\n".join(wrong)
     assert set(SIGNALS) <= found, f"signals that no longer exist: {set(SIGNALS) - found}"
+
+
+def test_one_import_style_relative_inside_the_package():
+    absolute = []
+    for name, path in modules().items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").split(".")[0] == "gcodekit":
+                absolute.append(f"{name}:{node.lineno} from {node.module} import ...")
+            elif isinstance(node, ast.Import):
+                absolute += [f"{name}:{node.lineno} import {a.name}" for a in node.names
+                             if a.name.split(".")[0] == "gcodekit"]
+    assert not absolute, "gcodekit's modules import each other relatively:\n" + "\n".join(absolute)
