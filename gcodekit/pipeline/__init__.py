@@ -137,7 +137,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         diagnostics.extend(op.diagnostics)  # its warnings
         op.diagnostics = diagnostics
     if plan and config.planner:
-        run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
+        op.attach_plan(run_planner(op, config.planner,
+                                   planner_settings(config.planner, config.planner_settings, machine_config)))
     if config.laser and op.waypoints is not None:
         op.waypoints["power"] = laser_power(op.waypoints)
     if config.process == "additive" and config.extruder_type == "filament" and op.waypoints is not None:

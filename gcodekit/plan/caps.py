@@ -15,18 +15,18 @@ import numpy as np
 from .moves import PlannerMoves
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 #: Capped speeds within this fraction of the programmed one are rounding, not a cap.
 TOLERANCE = 1e-6
 
 
-def report_feed_caps(op: "Operation", moves: PlannerMoves, allowed_v: np.ndarray, limits: str) -> float:
+def report_feed_caps(op: "EmulatedProgram", moves: PlannerMoves, allowed_v: np.ndarray, limits: str) -> float:
     """One info diagnostic when feed moves are programmed faster than ``allowed_v``; returns the time added, s.
 
     Parameters
     ----------
-    op : Operation
+    op : EmulatedProgram
         Its diagnostics receive the notice, at the first capped move's line.
     moves : PlannerMoves
         The firmware's moves; ``speed_v`` is what the program asks for, mm/s.
