@@ -123,8 +123,7 @@ class ModalHandler:
         distance = self._length(before, point, motion, [w.values.get(k, np.nan) for k in ("cx", "cy", "cz")])
         rate = w.values["feed"] if "feed" in w.values and motion != MOTION_RAPID else self._rate(motion)
         dwell = w.values.pop("dwell", 0.0)
-        w.values.update(distance=distance, time=(distance / (rate / 60.0) if distance and rate > 0 else 0.0) + dwell,
-                        de=0.0)
+        w.values.update(distance=distance, time=_duration(distance, rate, "feed" in w.values) + dwell, de=0.0)
         for k in ("cx", "cy", "cz"):
             w.values.setdefault(k, np.nan)
 
@@ -152,10 +151,18 @@ class ModalHandler:
         rate = self._rate(outcome.motion) if outcome.feed is None else outcome.feed
         path = distance or abs(outcome.de)
         out["distance"][row] = distance
-        out["time"][row] = (path / (rate / 60.0) if path and rate > 0 else 0.0) + outcome.dwell
+        out["time"][row] = _duration(path, rate, outcome.feed is not None) + outcome.dwell
         out["de"][row] = outcome.de
         out["feed"][row] = rate if outcome.feed is not None else s.feed
         out["motion"][row] = outcome.motion
         out["cx"][row], out["cy"][row], out["cz"][row] = outcome.centre
         out["spindle"][row] = s.speed * s.spindle
         s.fill_columns(row, out)
+
+
+def _duration(path: float, rate: float, rate_given: bool) -> float:
+    """Seconds to travel ``path`` mm at ``rate`` mm/min; NaN (unknown: the move never ends) when the
+    handler gave the move a rate of zero (a synchronized move at zero pitch or spindle speed)."""
+    if path and rate > 0:
+        return path / (rate / 60.0)
+    return float("nan") if path and rate_given else 0.0

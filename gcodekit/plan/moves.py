@@ -258,10 +258,15 @@ def _chords_within_limit(op, chords: np.ndarray, angle: np.ndarray, rows: np.nda
     counts = np.maximum(np.floor(chords * scale), 1.0).astype(np.int64)
     unplanned = angle / counts > np.pi / 2
     counts[unplanned] = 0
-    note = "; arcs too long for that are timed at their length over their feed" if unplanned.any() else ""
+    coarser = "planned with fewer chords, so their times are approximate"
+    if unplanned[worst]:
+        what = f"this one (asking for {chords[worst]:,.0f}) is timed at its length over its feed"
+        what += f"; other arcs are {coarser}" if (~unplanned).any() else ""
+    else:
+        what = f"{coarser} (this one asked for {chords[worst]:,.0f})"
+        what += "; arcs of many turns are timed at their length over their feed" if unplanned.any() else ""
     op.diagnostics.report(int(op.table.line[rows[worst]]), 1, f"arcs would be cut into {total:,.0f} moves, more than "
-                          f"max_motions={op.max_motions:,}; planned with fewer chords (this one asked for "
-                          f"{chords[worst]:,.0f}), so their times are approximate{note}", kind="limit")
+                          f"max_motions={op.max_motions:,}; {what}", kind="limit")
     return counts
 
 
