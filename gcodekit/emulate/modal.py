@@ -99,11 +99,12 @@ class ModalHandler:
             s.note_move()
         if outcome.believed is not None:
             s.keep_program_position(outcome.believed)
-        for w in outcome.passed:
+        passed = _dwells_apart(outcome.passed)
+        for w in passed:
             self._fill_passing(w, before)
             before = np.array([w.values[k] for k in AXES.lower()])
         self._write(out, row, before, outcome)
-        return outcome.passed
+        return passed
 
     def _read_feed(self, block: Block) -> None:
         """An F word sets the feed (in RS274NGC whatever else the block does; on firmware not beside an M code)."""
@@ -166,3 +167,17 @@ def _duration(path: float, rate: float, rate_given: bool) -> float:
     if path and rate > 0:
         return path / (rate / 60.0)
     return float("nan") if path and rate_given else 0.0
+
+
+def _dwells_apart(passed: list[Waypoint]) -> list[Waypoint]:
+    """A cycle's dwell at a point it passes (G82, G86, G89 at the bottom) as a waypoint of its own that does
+    not move, so planners time the move before it at its feed and the machine at rest for the dwell."""
+    if not any(w.values.get("dwell") for w in passed):
+        return passed
+    out = []
+    for w in passed:
+        dwell = w.values.pop("dwell", 0.0)
+        out.append(w)
+        if dwell:
+            out.append(Waypoint({**{k: w.values[k] for k in AXES.lower()}, "motion": MOTION_NONE, "dwell": dwell}))
+    return out

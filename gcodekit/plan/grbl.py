@@ -166,7 +166,9 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
     unplanned = np.flatnonzero((w["motion"] >= 3) & ~has_move & (w["distance"] > 0))
     if len(moves) == 0:
         return with_kept_steps(w, moves, empty_result(), unplanned) if unplanned.size else (moves, empty_result())
-    moves, result = _plan_moves(op, moves, config, follows_kept_step(moves, unplanned))
+    dwells = np.flatnonzero((w["motion"] == 0) & (np.asarray(w["time"], float) > 0))  # G4, and dwells in cycles
+    rest_before = follows_kept_step(moves, unplanned) | follows_kept_step(moves, dwells)
+    moves, result = _plan_moves(op, moves, config, rest_before)
     return with_kept_steps(w, moves, result, unplanned) if unplanned.size else (moves, result)
 
 

@@ -142,6 +142,7 @@ def plan(op: "Operation", config: MotionProfileConfig) -> tuple[PlannerMoves, Pl
 
     stop_before = happens_before(moves, command_rows(op, names=STOP_NAMES))
     stop_before |= follows_kept_step(moves, kept)
+    stop_before |= follows_kept_step(moves, np.flatnonzero((w["motion"] == 0) & (time > 0)))  # dwells in cycles
     exact_rows = command_rows(op, names=("exact_stop", "path_blending"))
     exact = in_force(moves, exact_rows, op.table.name[exact_rows] == NAME_ID["exact_stop"], 0.0) > 0
     last_of_step = np.append(moves.waypoint[1:] != moves.waypoint[:-1], True)[:len(moves)]
