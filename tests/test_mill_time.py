@@ -244,8 +244,10 @@ def test_moves_that_never_end_are_named(text, message):
     ("M3 S0 G95\nG1 X10 F0.1\n", "Cannot feed with zero spindle speed in feed per rev mode"),
     ("G18 G0 X5 Z0\nG76 P1 Z-10 I-0.5 J0.2 K1\n", "Chosen spindle (0) not turning in G76"),
     ("M5\nG33 Z-10 K1\n", "Spindle not turning in G33"),
+    ("G93\nG1 X10\n", "F word missing with inverse time g1 move"),
+    ("G93\nG2 X10 I5 J0\n", "F word missing with inverse time arc move"),
 ])
-def test_rs274_refuses_synchronized_moves_without_a_spindle(text, message):
+def test_rs274_refuses_moves_without_a_rate(text, message):
     # rs274 2.9's messages for these programs (checked with /usr/bin/rs274)
     op = gcodekit.gcode_to_operation("G21 G90\n" + text, "linuxcnc")
     (error,) = op.diagnostics.errors

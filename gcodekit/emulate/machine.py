@@ -501,6 +501,16 @@ class Machine:
         if s.feed_mode == "inverse_time":
             with np.errstate(divide="ignore"):
                 time[feeding] = 60.0 / feed[feeding]
+            missing = feeding & np.isnan(feed)  # G93 wants an F word on every feed move
+            if missing.any():
+                first = int(np.flatnonzero(missing)[0])
+                arc = motion[first] in (MOTION_CW, MOTION_CCW)
+                if self.rs274_blocks:
+                    self.diagnostics.report(int(t.line[rows][first]), 1, "F word missing with inverse time "
+                                            f"{'arc' if arc else 'g1'} move", kind="machine")
+                else:
+                    self.warn_once("inverse time F", int(t.line[rows][first]), "inverse time move (G93) without an "
+                                   "F word; its time is unknown")
             never = feeding & (feed == 0) & ((path > 0) | (rotary > 0))
             if never.any():  # rs274 accepts F0 in G93; the move would take forever
                 time[never] = np.nan
