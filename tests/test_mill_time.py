@@ -62,7 +62,7 @@ def run(text: str, planner: str):
 
 def row_time(op, times, line: int) -> float:
     """Time of the moves of source line ``line`` (1-based, counting the header line)."""
-    rows = np.asarray(op.waypoints["command"]) if "command" in op.waypoints else np.arange(times.size)
+    rows = np.asarray(op.waypoints["command"])
     return float(np.nansum(times[op.table.line[rows] == line]))
 
 

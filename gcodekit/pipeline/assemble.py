@@ -32,10 +32,9 @@ def concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarra
     """Join per-chunk waypoint columns, one column at a time to bound memory."""
     if len(parts) == 1:
         return parts[0]
-    if any("command" in p for p in parts):
-        shift = np.cumsum([0] + sizes[:-1])
-        for p, s, n in zip(parts, shift, sizes):
-            p["command"] = p.get("command", np.arange(n)) + s
+    shift = np.cumsum([0] + sizes[:-1])
+    for p, s in zip(parts, shift):  # each chunk counts its commands from 0
+        p["command"] = p["command"] + s
     out = {}
     for key in list(parts[0]):
         cols = [p.pop(key) for p in parts]
@@ -83,7 +82,7 @@ def warn_implausible_time(op: Operation) -> None:
     if not total > PLAUSIBLE_TIME_S:
         return
     longest = int(np.argmax(time))
-    row = int(op.waypoints["command"][longest]) if "command" in op.waypoints else longest
+    row = int(op.waypoints["command"][longest])
     years = total / (365.25 * 86400.0)
     op.diagnostics.warn(int(op.table.line[row]), 1, f"the program would run for {years:,.1f} years (more than a "
                         f"year, no real job); this step alone takes {time[longest] / 86400.0:,.1f} days")

@@ -34,7 +34,7 @@ from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, foll
                     with_kept_steps)
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 MINIMUM_FEED_RATE = 1.0 / 60.0  # grbl config.h: MINIMUM_FEED_RATE 1.0 mm/min
 MINIMUM_JUNCTION_SPEED = 0.0  # grbl config.h, mm/s
@@ -144,7 +144,7 @@ REST_NAMES = (
 SPINDLE_NAMES = ("spindle_cw", "spindle_ccw", "spindle_off")
 
 
-def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]:
     """Plan an emulated operation as GRBL 1.1 would; one result per firmware move.
 
     Examples
@@ -172,7 +172,7 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
     return with_kept_steps(w, moves, result, unplanned) if unplanned.size else (moves, result)
 
 
-def _plan_moves(op: "Operation", moves: PlannerMoves, config: GrblConfig,
+def _plan_moves(op: "EmulatedProgram", moves: PlannerMoves, config: GrblConfig,
                 rest_before: np.ndarray) -> tuple[PlannerMoves, PlanResult]:
     """GRBL's lookahead over the firmware moves; ``rest_before``: moves that start from rest."""
     n = len(moves)
@@ -215,7 +215,7 @@ def _plan_moves(op: "Operation", moves: PlannerMoves, config: GrblConfig,
     return moves, trapezoid(move_d, acceleration, entry_v2, nominal**2, exit_v2)
 
 
-def _spindle_syncs(op: "Operation", moves: PlannerMoves, config: GrblConfig) -> np.ndarray:
+def _spindle_syncs(op: "EmulatedProgram", moves: PlannerMoves, config: GrblConfig) -> np.ndarray:
     """Per move: did a spindle change (M3/M4/M5, or a new S while on) stop the machine before it?
 
     grbl 1.1 ``gc_execute_line`` calls ``spindle_sync`` (a buffer sync) for

@@ -37,7 +37,7 @@ from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, foll
                     in_force, with_kept_steps)
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 #: Commands before which the machine has come to rest.
 STOP_NAMES = (
@@ -112,7 +112,7 @@ class MotionProfileConfig:
         return profile
 
 
-def plan(op: "Operation", config: MotionProfileConfig) -> tuple[PlannerMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: MotionProfileConfig) -> tuple[PlannerMoves, PlanResult]:
     """Plan an emulated operation with a :class:`MotionProfile`; one result per move."""
     w = op.waypoints
     n_wp = w["x"].size
