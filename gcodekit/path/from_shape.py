@@ -23,7 +23,7 @@ G1 X3.000000 Y3.000000
 >>> from shapely.geometry import box
 >>> p = from_shape(box(0, 0, 10, 5), safe_height=5, final_depth=-2, step_down=1, feed=300)
 >>> [c.toGCode() for c in p.Commands][:6]
-['G0 Z5.000000', 'G0 X10.000000 Y0.000000', 'G1 Z-1.000000', 'G1 F300.000000 X10.000000 Y5.000000', 'G1 X0.000000', 'G1 Y0.000000']
+['G0 Z5.000000', 'G0 X10.000000 Y0.000000', 'G1 F300.000000 Z-1.000000', 'G1 Y5.000000', 'G1 X0.000000', 'G1 Y0.000000']
 """
 
 from __future__ import annotations
@@ -161,7 +161,7 @@ def from_shape(shape: "Sequence | BaseGeometry", *, feed: float | None = None, v
             commands.append(Command("G1", {"Z": depth, **({"F": float(plunge)} if plunge is not None else {})}))
             pos[2] = depth
             for k, p in enumerate(xy[1:]):
-                c = _move("G1", pos, [p[0], p[1], depth], feed if k == 0 else None)
+                c = _move("G1", pos, [p[0], p[1], depth], feed if k == 0 and feed != plunge else None)
                 if c is not None:
                     commands.append(c)
                 pos[:2] = list(p)

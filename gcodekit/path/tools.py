@@ -21,6 +21,7 @@ ToolShape(kind='drill', diameter=12.7, length=30.0, corner_radius=0.0, angle=118
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import Iterable
 
@@ -39,6 +40,10 @@ TOOL_TYPES: dict[str, str] = {
 #: FreeCAD 0.20's tool materials (``Tool.getToolMaterials()``).
 TOOL_MATERIALS = ("Carbide", "HighSpeedSteel", "HighCarbonToolSteel", "CastAlloy", "Ceramics", "Diamond", "Sialon")
 
+#: XML attribute -> Tool field, in FreeCAD's order (its ``Tool::Save``)
+XML_ATTRS = {"name": "name", "diameter": "diameter", "length": "lengthOffset", "flat": "flatRadius",
+             "corner": "cornerRadius", "angle": "cuttingEdgeAngle", "height": "cuttingEdgeHeight",
+             "type": "tooltype", "mat": "material"}
 _ATTRS = (("name", "Name"), ("tooltype", "ToolType"), ("material", "Material"), ("diameter", "Diameter"),
           ("lengthOffset", "LengthOffset"), ("flatRadius", "FlatRadius"), ("cornerRadius", "CornerRadius"),
           ("cuttingEdgeAngle", "CuttingEdgeAngle"), ("cuttingEdgeHeight", "CuttingEdgeHeight"))
@@ -111,6 +116,15 @@ class Tool:
 
     def copy(self) -> "Tool":
         return Tool(**{k: getattr(self, k) for k, _ in _ATTRS})
+
+    @property
+    def Content(self) -> str:  # noqa: N802
+        """The tool as FreeCAD's XML element (as ``Tool.Content`` is in FreeCAD 0.20)."""
+        return ET.tostring(self._element(), encoding="unicode") + "\n"
+
+    def _element(self) -> ET.Element:
+        return ET.Element("Tool", {attr: f"{getattr(self, field):g}" if attr not in ("name", "type", "mat")
+                                   else str(getattr(self, field)) for attr, field in XML_ATTRS.items()})
 
     @staticmethod
     def getToolTypes() -> list[str]:  # noqa: N802
@@ -221,6 +235,15 @@ class Tooltable:
             tool = Tool()
             tool.setFromTemplate(v)
             self._tools[int(k)] = tool
+
+    @property
+    def Content(self) -> str:  # noqa: N802
+        """The table as FreeCAD's XML (as ``Tooltable.Content`` is in FreeCAD 0.20)."""
+        root = ET.Element("Tooltable", count=str(len(self._tools)))
+        for number, tool in sorted(self._tools.items()):
+            ET.SubElement(root, "Toolslot", number=str(number)).append(tool._element())
+        ET.indent(root, "    ")
+        return ET.tostring(root, encoding="unicode") + "\n"
 
     def copy(self) -> "Tooltable":
         out = Tooltable(self._tools, name=self.Name)

@@ -27,16 +27,12 @@ import xml.etree.ElementTree as ET
 
 from ..emulate.tooltable import ToolTable
 from ..errors import ConfigError
-from .tools import Tool, Tooltable
+from .tools import XML_ATTRS, Tool, Tooltable
 
 __all__ = ["read_tooltable", "write_tooltable", "tooltable_from_text", "tooltable_to_json", "tooltable_to_xml",
            "tooltable_to_tbl"]
 
 _FORMATS = {".json": "json", ".xml": "xml", ".tbl": "tbl"}
-# XML attribute -> Tool field (FreeCAD's Tool::Save)
-_XML = {"name": "name", "diameter": "diameter", "length": "lengthOffset", "flat": "flatRadius",
-        "corner": "cornerRadius", "angle": "cuttingEdgeAngle", "height": "cuttingEdgeHeight",
-        "type": "tooltype", "mat": "material"}
 
 
 def tooltable_from_text(text: str, fmt: str, *, units: str = "mm", source: str = "<tool table>") -> Tooltable:
@@ -96,7 +92,7 @@ def _from_xml(text: str, source: str) -> Tooltable:
         element = slot.find("Tool")
         if element is None or "number" not in slot.attrib:
             raise ConfigError(f"{source}: a <Toolslot> without a number or a <Tool>")
-        values = {field: element.attrib[attr] for attr, field in _XML.items() if attr in element.attrib}
+        values = {field: element.attrib[attr] for attr, field in XML_ATTRS.items() if attr in element.attrib}
         for key in ("diameter", "lengthOffset", "flatRadius", "cornerRadius", "cuttingEdgeAngle", "cuttingEdgeHeight"):
             if key in values:
                 try:
@@ -116,13 +112,7 @@ def tooltable_to_json(table: Tooltable) -> str:
 
 def tooltable_to_xml(table: Tooltable) -> str:
     """FreeCAD's XML text for the table (``Tooltable.Content``)."""
-    root = ET.Element("Tooltable", count=str(len(table)))
-    for number, tool in table.Tools.items():
-        slot = ET.SubElement(root, "Toolslot", number=str(number))
-        ET.SubElement(slot, "Tool", {attr: f"{getattr(tool, field):g}" if isinstance(getattr(tool, field), float)
-                                     else str(getattr(tool, field)) for attr, field in _XML.items()})
-    ET.indent(root, "    ")
-    return ET.tostring(root, encoding="unicode") + "\n"
+    return table.Content
 
 
 def tooltable_to_tbl(table: Tooltable) -> str:
