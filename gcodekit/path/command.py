@@ -25,9 +25,13 @@ from .rules import command_gcode, parse_command
 __all__ = ["Command"]
 
 
-def _number(key: object, value: object) -> float:
+def _key(key: object) -> str:
     if not isinstance(key, str):
         raise TypeError("The dictionary can only contain string keys")
+    return key.upper()
+
+
+def _number(key: str, value: object) -> float:
     if not isinstance(value, Real):
         raise TypeError("The dictionary can only contain number values")
     value = float(value)
@@ -92,7 +96,7 @@ class Command:
 
     @Parameters.setter
     def Parameters(self, value: dict[str, float]) -> None:  # noqa: N802
-        self._params = {k.upper(): _number(k, v) for k, v in value.items()}
+        self._params = {_key(k): _number(k, v) for k, v in value.items()}
 
     @property
     def Placement(self) -> Placement:  # noqa: N802

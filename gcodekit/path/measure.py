@@ -2,7 +2,7 @@
 
 :func:`walk` follows the commands the way a controller does: omitted axes
 keep their value, G91 makes X/Y/Z relative, arcs are centred at the start
-plus I/J/K (G90.1: at I/J/K) in the plane of G17/G18/G19, drilling cycles
+plus I/J/K (G90.1: at I/J/K) in the plane of G17/G18/G19 (an R-form arc's centre found from its radius), drilling cycles
 G81-G89 go down to Z and back.  :func:`length` and :func:`bound_box` are
 measured on it exactly: an arc's length is its radius times its swept angle
 (a full circle is 2 pi r, a helix adds its rise), its box reaches the
@@ -115,9 +115,12 @@ def walk(commands: Commands) -> list[Segment]:
             if axis in p:
                 end[k] = p[axis] if absolute else pos[k] + p[axis]
         if name in _CW + _CCW:
-            offset = np.array([p.get("I", 0.0), p.get("J", 0.0), p.get("K", 0.0)])
-            center = offset if center_absolute else pos + offset
             a, b, _ = plane
+            if "R" in p and not any(k in p for k in "IJK"):
+                center = _r_centre(pos, end, p["R"], plane, name in _CW)
+            else:
+                offset = np.array([p.get("I", 0.0), p.get("J", 0.0), p.get("K", 0.0)])
+                center = offset if center_absolute else pos + offset
             t0 = math.atan2(pos[b] - center[b], pos[a] - center[a])
             t1 = math.atan2(end[b] - center[b], end[a] - center[a])
             sign = -1.0 if name in _CW else 1.0
@@ -143,6 +146,28 @@ def walk(commands: Commands) -> list[Segment]:
             out.append(Segment("rapid" if name in _RAPID else "feed" if name in _FEED else "probe", i, pos, end))
         pos = end
     return out
+
+
+def _r_centre(start: np.ndarray, end: np.ndarray, radius: float, plane: tuple[int, int, int],
+              clockwise: bool) -> np.ndarray:
+    """An R-form arc's centre (RS274NGC): R > 0 the shorter way round, R < 0 the longer.
+
+    A radius too short for the chord is taken as half the chord (a half
+    circle), the nearest arc there is.
+    """
+    a, b, _ = plane
+    dx, dy = end[a] - start[a], end[b] - start[b]
+    chord = math.hypot(dx, dy)
+    center = start.copy()
+    if chord == 0:
+        return center
+    r = max(abs(radius), chord / 2)
+    h = math.sqrt(max(r * r - chord * chord / 4, 0.0))
+    # the centre lies right of the chord (seen from start to end) for a short clockwise arc
+    side = -1.0 if clockwise == (radius > 0) else 1.0
+    center[a] = start[a] + dx / 2 - side * h * dy / chord
+    center[b] = start[b] + dy / 2 + side * h * dx / chord
+    return center
 
 
 def length(commands: Commands) -> float:

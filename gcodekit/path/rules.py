@@ -25,8 +25,9 @@ text and a LinuxCNC ``#<name>`` abort FreeCAD's whole process and are a
 skips inside a number (``X#1``, ``X[1+2]``, ``X1*57``) are an error rather
 than a wrong number; ``;`` starts a comment to the end of the line; after
 ``G20`` the arc's ``K`` is scaled like ``I`` and ``J`` (FreeCAD forgets it);
-numbers beyond 9.2e11 are written as they are (FreeCAD overflows a 64-bit
-integer and writes ``-922337203685.477581``).
+numbers beyond 9e8 mm are written as they are (FreeCAD's double arithmetic
+writes 922337203685 as ``922337203684.999987`` and overflows a 64-bit
+integer from 922337203686, writing ``-922337203685.477581``).
 
 Examples
 --------
@@ -42,6 +43,7 @@ import bisect
 import math
 import re
 from dataclasses import dataclass
+from decimal import Decimal
 
 from ..errors import Diagnostics, GcodeSyntaxError
 
@@ -58,6 +60,9 @@ _ATOF = re.compile(r"-?(?:\d+\.?\d*|\.\d+)")
 _CUT = re.compile(r"[(gGmM]")
 _ALLOWED_IN_COMMAND = re.compile(r"(?:[A-Za-z]\s*\+|[A-Za-z0-9.\-\s%])*")  # a '+' sign only after a letter
 _INT64 = 1 << 63
+#: Below this FreeCAD's ``value * 1e7`` is exact to the unit it rounds; above, gcodekit writes the decimal
+#: value itself (FreeCAD writes 922337203685 as 922337203684.999987, and overflows from 922337203686)
+_EXACT_BELOW = 2.0**53 / 1e7
 
 
 class FreeCADFormatError(GcodeSyntaxError):
@@ -78,8 +83,8 @@ def _atof(text: str) -> float:
 def format_value(value: float) -> str:
     """A parameter as FreeCAD 0.20 writes it: six decimals, rounded half away from zero.
 
-    Unlike FreeCAD, values too large for its 64-bit arithmetic are written
-    correctly.
+    Unlike FreeCAD, values beyond 9e8 (where its arithmetic loses the sixth
+    decimal and then overflows) are written correctly.
 
     Examples
     --------
@@ -89,11 +94,10 @@ def format_value(value: float) -> str:
     value = float(value)
     if not math.isfinite(value):
         raise ValueError(f"cannot write {value} as a G-code number")
-    scaled = value * 1e7
-    if abs(scaled) < _INT64:
+    if abs(value) < _EXACT_BELOW:
         return freecad_format_value(value)
     sign = "-" if value < 0 else ""
-    units = (int(abs(value) * 10**7) + 5) // 10  # Python's integers do not overflow
+    units = (int(Decimal(abs(value)) * 10**7) + 5) // 10  # the double's exact value; no overflow
     return f"{sign}{units // 10**6}.{units % 10**6:06d}"
 
 
