@@ -28,7 +28,7 @@ STAGES: list[tuple[str, ...]] = [
     ("gcodekit.model",),
     ("gcodekit.analysis", "gcodekit.additive", "gcodekit.export", "gcodekit.visualize", "gcodekit.transpile"),
     ("gcodekit.pipeline",),
-    ("gcodekit.report", "gcodekit.widgets", "gcodekit.cli", "gcodekit.testing", "gcodekit"),
+    ("gcodekit.report", "gcodekit.widgets", "gcodekit.cli", "gcodekit.testing", "gcodekit.path", "gcodekit"),
 ]
 #: Where an import may reach a later stage: the Operation's convenience methods, lazily, into the outputs.
 CONVENIENCE = ("gcodekit.model.operation", 8)

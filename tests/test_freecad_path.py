@@ -143,8 +143,10 @@ def test_splitting_agrees_and_semicolon_comments_are_comments():
     ("G91 G0 X1 G0 X1 G0 Y2", 4.0, [0, 0, 0, 2, 2, 0]),
     # XZ plane (G18), clockwise seen from +Y (Z right, X up) about (2, 1, 0) from (1, 1, 0): through Z = -1
     ("G0 X1 Y1 G18 G2 X3 Z0 I1 K0", math.sqrt(2) + math.pi, [0, 0, -1, 3, 1, 0]),
-    # a drilling cycle from Z5: to X1 Y1, down to R1 then Z-1, back up to the start height (G98)
-    ("G0 Z5 G81 X1 Y1 Z-1 R1 G80", 5 + math.sqrt(2) + 4 + 2 + 6, [0, 0, -1, 1, 1, 5]),
+    # a drilling cycle from Z5: to X1 Y1, down to R1 then Z-1, back up to R (G99, LinuxCNC's start)
+    ("G0 Z5 G81 X1 Y1 Z-1 R1 G80", 5 + math.sqrt(2) + 4 + 2 + 2, [0, 0, -1, 1, 1, 5]),
+    # ... or to the height it started from (G98)
+    ("G0 Z5 G98 G81 X1 Y1 Z-1 R1 G80", 5 + math.sqrt(2) + 4 + 2 + 6, [0, 0, -1, 1, 1, 5]),
 ])
 def test_length_and_box_are_exact(text, length, box):
     p = gpath.Path(text)
@@ -172,7 +174,7 @@ PIPELINE_MEASURED = ["nc_files/tort.ngc", "nc_files/plasmatest.ngc", "nc_files/c
 def test_exact_length_is_the_pipelines_distance(name):
     program, _ = _corpus()[name]
     path = gpath.Path(_text(program))
-    op = path.to_operation(plan=False)
+    op = gpath.to_operation(path, plan=False)
     assert path.Length == pytest.approx(float(op.waypoints["distance"].sum()), rel=1e-9)
 
 

@@ -3,7 +3,8 @@
 :func:`walk` follows the commands the way a controller does: omitted axes
 keep their value, G91 makes X/Y/Z relative, arcs are centred at the start
 plus I/J/K (G90.1: at I/J/K) in the plane of G17/G18/G19 (an R-form arc's centre found from its radius), drilling cycles
-G81-G89 go down to Z and back.  :func:`length` and :func:`bound_box` are
+G81-G89 go down to Z and back to R (G99, LinuxCNC's start) or to the height
+they started from (G98).  :func:`length` and :func:`bound_box` are
 measured on it exactly: an arc's length is its radius times its swept angle
 (a full circle is 2 pi r, a helix adds its rise), its box reaches the
 circle's extreme points.
@@ -96,7 +97,8 @@ class Segment:
 def walk(commands: Commands) -> list[Segment]:
     """The motions of FreeCAD path commands, as a controller reads them (see the module)."""
     pos = np.zeros(3)
-    absolute, center_absolute, plane, retract_initial = True, False, _PLANES["G17"], True
+    # LinuxCNC starts in G99 (retract to R), as rs274 does
+    absolute, center_absolute, plane, retract_initial = True, False, _PLANES["G17"], False
     out: list[Segment] = []
     for i, (name, p) in enumerate(commands):
         if name in _PLANES:

@@ -41,15 +41,15 @@ from ..errors import ConfigError, did_you_mean
 from ..export.gcode import GcodeExporter
 from ..pipeline import gcode_to_operation, parse_program
 from .command import Command
-from .job import Compound
 from .toolpath import Path
 
 if TYPE_CHECKING:
     from ..model.operation import Operation
+    from .job import Compound
 
 __all__ = ["read", "from_operation", "to_operation", "post_process", "TARGETS", "Target"]
 
-Pathlike = Union[Path, Compound]
+Pathlike = Union[Path, "Compound"]
 
 
 @dataclass(frozen=True)
@@ -75,7 +75,7 @@ class Target:
 TARGETS: dict[str, Target] = {
     "linuxcnc": Target("rs274ngc", "linuxcnc", ("G21 G90 G17 G40 G80",), ("M5", "M2")),
     "grbl": Target("grbl", "grbl", ("G21 G90 G17",), ("M5", "M2"), tool_change="pause"),
-    "fanuc": Target("fanuc", "fanuc", ("G21 G90 G17 G40 G80",), ("M5", "M30"), line_numbers=True, percent=True),
+    "fanuc": Target("fanuc", "fanuc", ("G21 G90 G17 G40 G80 G99",), ("M5", "M30"), line_numbers=True, percent=True),
     "marlin": Target("marlin", "marlin", ("G21", "G90"), ("M5",), tool_change="pause"),
     "ger": Target("ger", "ger", ("G21 G90 G17",), ("M5", "M2")),
 }
@@ -89,10 +89,11 @@ def _target(name: str) -> Target:
 
 
 def _as_path(obj: Pathlike) -> Path:
-    if isinstance(obj, Compound):
-        return obj.Path
     if isinstance(obj, Path):
         return obj
+    joined = getattr(obj, "Path", None)  # a Compound or Job (not imported: job.py imports the path)
+    if isinstance(joined, Path):
+        return joined
     raise TypeError(f"expected a Path or a Job, not {type(obj).__name__}")
 
 
@@ -243,7 +244,7 @@ _CYCLES = ("G81", "G82", "G83")
 
 
 def _expand_cycles(path: Path) -> Path:
-    """The path with each G81/G82/G83 drilling cycle written as the moves it makes (G98 retract).
+    """The path with each G81/G82/G83 drilling cycle written as the moves it makes (G98/G99 followed).
 
     Positions come from :func:`gcodekit.path.measure.walk`, which follows
     G90/G91, planes and omitted words; G80 goes, as nothing is left to cancel.

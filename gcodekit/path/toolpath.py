@@ -20,16 +20,13 @@ G91; see :mod:`gcodekit.path.measure`); :meth:`Path.freecad_length` and
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Iterable
+from typing import Iterable
 
 from ..errors import Diagnostics
 from .command import Command
 from .geometry import BoundBox, Vector
 from .measure import bound_box, freecad_bound_box, freecad_length, length, walk
 from .rules import read_commands, read_strict
-
-if TYPE_CHECKING:
-    from ..model.operation import Operation
 
 __all__ = ["Path"]
 
@@ -200,15 +197,6 @@ class Path:
     def segments(self):
         """The path's motions as :class:`~gcodekit.path.measure.Segment` objects."""
         return walk(self._pairs())
-
-    def to_operation(self, machine: str = "linuxcnc", **options) -> "Operation":
-        """Run the path through gcodekit's pipeline: a planned :class:`~gcodekit.model.operation.Operation`.
-
-        See :func:`gcodekit.path.processing.to_operation`.
-        """
-        from .processing import to_operation
-
-        return to_operation(self, machine, **options)
 
     def _pairs(self) -> list[tuple[str, dict[str, float]]]:
         return [(c._name, c._params) for c in self._commands]
