@@ -24,12 +24,12 @@ from .command import Command
 from .from_shape import from_shape, fromShape
 from .geometry import BoundBox, Placement, Rotation, Vector
 from .job import Compound, Job
-from .processing import TARGETS, from_operation, post_process, read, to_operation
+from .processing import TARGETS, from_operation, post_process, read, to_operation, write_report
 from .rules import FreeCADFormatError
 from .toolpath import Path
 from .tools import Tool, ToolBit, Tooltable
 from .tooltable_files import read_tooltable, write_tooltable
 
 __all__ = ["Command", "Path", "Tool", "Tooltable", "ToolBit", "Compound", "Job", "from_shape", "fromShape",
-           "read", "post_process", "to_operation", "from_operation", "read_tooltable", "write_tooltable",
+           "read", "post_process", "to_operation", "from_operation", "write_report", "read_tooltable", "write_tooltable",
            "Vector", "Placement", "Rotation", "BoundBox", "FreeCADFormatError", "TARGETS"]

@@ -47,7 +47,7 @@ if TYPE_CHECKING:
     from ..model.operation import Operation
     from .job import Compound
 
-__all__ = ["read", "from_operation", "to_operation", "post_process", "TARGETS", "Target"]
+__all__ = ["read", "from_operation", "to_operation", "post_process", "write_report", "TARGETS", "Target"]
 
 Pathlike = Union[Path, "Compound"]
 
@@ -183,6 +183,29 @@ def to_operation(obj: Pathlike, machine: str = "linuxcnc", **options) -> "Operat
     path = _as_path(obj)
     options.setdefault("flavor", "rs274ngc")
     return gcode_to_operation(path.toGCode(), machine, **options)
+
+
+def write_report(obj: Pathlike, out_dir: str | os.PathLike, *, name: str = "path",
+                 target: str = "linuxcnc", pdf: bool = False) -> dict:
+    """The HTML report of a path or job, as ``gcodekit report`` writes one for a program file.
+
+    The path is post-processed for ``target`` into ``out_dir/<name>.ngc``
+    (kept beside the report) and reported on the target's machine; ``pdf``
+    also prints the page to PDF (needs Chromium).
+
+    Returns
+    -------
+    dict
+        The report's index row (``html``, key figures; ``error`` if it failed).
+    """
+    from ..report.batch import ReportOptions, report_program
+
+    out = os.fspath(out_dir)
+    os.makedirs(out, exist_ok=True)
+    program = os.path.join(out, f"{name}.ngc")
+    with open(program, "w", encoding="utf-8") as f:
+        f.write(post_process(obj, target, name=name))
+    return report_program(program, out, name, ReportOptions(machine=_target(target).machine, pdf=pdf))
 
 
 # -- post-processing ------------------------------------------------------------------------
