@@ -35,5 +35,6 @@ def test_layer_viewer_and_velocity_plot_show_a_job():
 def test_a_job_gets_a_report(tmp_path):
     row = Path.write_report(_job(), tmp_path, name="pocket")
     assert row.get("error") is None, row["error"]
+    assert row["distance_mm"] == pytest.approx(_job().Path.Length, rel=1e-9)  # 5 + 6 + 20 + 5 pi + 20 + 10 + 6
     page = (tmp_path / row["html"]).read_text()
-    assert "pocket" in page and (tmp_path / "pocket.ngc").read_text().startswith("(gcodekit: post-processed")
+    assert "pocket" in page and (tmp_path / "pocket.ngc").read_text().startswith("(pocket: post-processed by gcodekit for linuxcnc)")
