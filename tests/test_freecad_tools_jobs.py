@@ -195,3 +195,21 @@ def test_from_shape_rejects_what_it_cannot_follow():
         Path.from_shape([(0, 0)])
     with pytest.raises(TypeError, match="shapely geometry"):
         Path.from_shape("square")
+
+
+def test_readme_freecad_example_runs(tmp_path, monkeypatch, capsys):
+    """The README's FreeCAD section is the seed page's examples; they run as written."""
+    readme = (FilePath(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme.split("## FreeCAD users", 1)[1]
+    code = section.split("```python\n", 1)[1].split("```", 1)[0]
+    (tmp_path / "program.ngc").write_text("G21\nG0 X1 Y1\nG1 X5 F100\nM2\n")
+    monkeypatch.chdir(tmp_path)
+    scope: dict = {}
+    exec(compile(code, "README.md", "exec"), scope)
+    out = capsys.readouterr().out
+    assert out.startswith("G1 X1.000000\nG1 Y4.000000\nG1 X2.000000 Y2.000000\n")
+    assert "M6 T2" in out and "M6 T1" in out
+    assert repr(scope["c5"]) == "Command G1 [ X:3 Y:2 Z:1 ]"
+    assert repr(scope["table"].Tools) == "{1: Tool 12.7mm Drill Bit, 2: Tool my other tool}"
+    assert [c.Name for c in scope["imported"].Commands] == ["G0", "G1"]
+    assert scope["op"].emulated
