@@ -358,3 +358,37 @@ def test_the_preprocessor_never_crashes_on_the_corpus():
             assert d.line >= 0 and d.column >= 0 and d.message
         with_diagnostics += len(path.diagnostics) > 0
     assert with_diagnostics == 92
+
+
+# -- properties -----------------------------------------------------------------------------------
+
+from hypothesis import given  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_names = st.sampled_from(["G0", "G1", "G2", "G3", "G01", "G38.2", "G81", "M3", "M5", "M6", "G17", "G90", "G91"])
+_values = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False).map(lambda v: round(v, 6))
+_params = st.dictionaries(st.sampled_from(list("ABCFIJKPQRSTXYZ")), _values, max_size=6)
+
+
+@given(st.lists(st.tuples(_names, _params), max_size=12))
+def test_what_topath_writes_reads_back_to_the_same_commands(commands):
+    path = gpath.Path([gpath.Command(n, p) for n, p in commands])
+    again = gpath.Path(path.toGCode())
+    assert [c.Name for c in again.Commands] == [n for n, _ in commands]
+    for c, (_, p) in zip(again.Commands, commands):
+        assert c.Parameters.keys() == p.keys()
+        assert all(abs(c.Parameters[k] - v) <= 5e-7 for k, v in p.items())
+    assert again.toGCode() == path.toGCode()
+
+
+@given(st.lists(st.tuples(_names, _params), max_size=12))
+def test_freecads_length_and_box_never_exceed_the_exact_box(commands):
+    """FreeCAD's sampled box lies inside the exact one: every sampled point is on the path."""
+    path = gpath.Path([gpath.Command(n, p) for n, p in commands])
+    exact, sampled = path.BoundBox, path.freecad_bound_box()
+    if any(n in ("G81", "G38.2") for n, _ in commands):
+        return  # FreeCAD retracts cycles as G98 does (LinuxCNC starts in G99): another path
+    if sampled.isValid():
+        tol = 1e-6 * (1 + max(abs(v) for v in exact.as_list()))
+        assert sampled.XMin >= exact.XMin - tol and sampled.XMax <= exact.XMax + tol
+        assert sampled.YMin >= exact.YMin - tol and sampled.YMax <= exact.YMax + tol

@@ -76,7 +76,7 @@ def test_post_processed_job_moves_alike_when_read_back(target, reference):
 def test_targets_get_their_headers_tool_changes_and_line_numbers():
     job = _job()
     linuxcnc = Path.post_process(job, "linuxcnc")
-    assert linuxcnc.splitlines()[0] == "(gcodekit: post-processed by gcodekit for linuxcnc)"
+    assert linuxcnc.splitlines()[0] == "(program: post-processed by gcodekit for linuxcnc)"
     assert "(T2: 6 mm drill, Drill, D6 mm)" in linuxcnc and "G21 G90 G17 G40 G80" in linuxcnc
     assert "M6 T2" in linuxcnc and linuxcnc.rstrip().endswith("M2")
     fanuc = Path.post_process(job, "fanuc", program_number=42)
@@ -90,7 +90,7 @@ def test_targets_get_their_headers_tool_changes_and_line_numbers():
         grbl = Path.post_process(job, "grbl")
         marlin = Path.post_process(job, "marlin")
     assert not any(ln.startswith("G81") for ln in grbl.splitlines()) and "(change to tool 2)" in grbl and "\nM0\n" in grbl  # no tool changer: a pause
-    assert marlin.startswith(";gcodekit: post-processed") and "(" not in marlin.replace("(from", "")
+    assert marlin.startswith(";program: post-processed") and "(" not in marlin.replace("(from", "")
     ger = Path.post_process(job, "ger")
     assert "G21" in ger.split("(slot)")[0]  # GER starts in inches
 

@@ -211,7 +211,7 @@ def write_report(obj: Pathlike, out_dir: str | os.PathLike, *, name: str = "path
 # -- post-processing ------------------------------------------------------------------------
 
 def post_process(obj: Pathlike, target: str = "linuxcnc", *, header: bool = True, line_numbers: bool | None = None,
-                 program_number: int = 1, name: str = "gcodekit", precision: int = 4) -> str:
+                 program_number: int = 1, name: str = "program", precision: int = 4) -> str:
     """A path or job written for a controller: the post-processor.
 
     Parameters
@@ -223,7 +223,7 @@ def post_process(obj: Pathlike, target: str = "linuxcnc", *, header: bool = True
     line_numbers : bool, default: the target's (Fanuc: yes)
     program_number : int, default: 1
         Fanuc's ``O`` number.
-    name : str, default: "gcodekit"
+    name : str, default: "program"
         The program's name in the header.
     precision : int, default: 4
         Decimals of coordinates.

@@ -89,8 +89,11 @@ class Path:
         """
         path = cls()
         path.diagnostics = Diagnostics(file, mode)
-        path._commands = [_command(n, p) for n, p, _ in
-                          read_commands(text, path.diagnostics, freecad=freecad_compatible)]
+        if mode == "strict":  # FreeCAD's error type, with the first problem's place
+            commands = read_strict(text, file, freecad=freecad_compatible)
+        else:
+            commands = read_commands(text, path.diagnostics, freecad=freecad_compatible)
+        path._commands = [_command(n, p) for n, p, _ in commands]
         return path
 
     # -- FreeCAD's attributes ------------------------------------------------------------
