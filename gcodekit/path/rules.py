@@ -120,9 +120,9 @@ def freecad_format_value(value: float) -> str:
     return f"{sign}{units // 10**6}.{units % 10**6:06d}"
 
 
-def command_gcode(name: str, params: dict[str, float], *, fmt=format_value) -> str:
+def command_gcode(name: str, params: dict[str, float]) -> str:
     """A command's ``toGCode()`` text: its name, then ``KEYvalue`` in key order, ``N`` left out."""
-    words = [name] + [f"{k}{fmt(v)}" for k, v in sorted(params.items()) if k != "N"]
+    words = [name] + [f"{k}{format_value(v)}" for k, v in sorted(params.items()) if k != "N"]
     return " ".join(words)
 
 

@@ -58,7 +58,7 @@ class Path:
 
     def __init__(self, commands: "Iterable[Command] | str | None" = None):
         self._commands: list[Command] = []
-        self.diagnostics = Diagnostics("<path>", "strict")
+        self.diagnostics = Diagnostics("<path>")  # what reading found (from_gcode, read); empty here
         self.Center = Vector()
         if isinstance(commands, str):
             self.setFromGCode(commands)

@@ -34,7 +34,7 @@ __all__ = ["Tool", "Tooltable", "ToolBit", "TOOL_TYPES", "TOOL_MATERIALS"]
 TOOL_TYPES: dict[str, str] = {
     "EndMill": "endmill", "Drill": "drill", "CenterDrill": "drill", "CounterSink": "chamfer",
     "CounterBore": "endmill", "FlyCutter": "endmill", "Reamer": "endmill", "Tap": "endmill",
-    "SlotCutter": "endmill", "BallEndMill": "ballend", "ChamferMill": "chamfer", "CornerRound": "bullnose",
+    "SlotCutter": "endmill", "BallEndMill": "ballend", "ChamferMill": "chamfer", "CornerRound": "endmill",
     "Engraver": "vbit",
 }
 #: FreeCAD 0.20's tool materials (``Tool.getToolMaterials()``).
@@ -153,13 +153,11 @@ class Tool:
         chamfer mills take the cutting edge angle (180, FreeCAD's default,
         means the kind's usual angle); a chamfer mill's flat radius is its
         tip.  Types without a shape of their own (tap, reamer, counterbore,
-        slot and fly cutters) are drawn as end mills.
+        slot, fly and corner-rounding cutters, Undefined) are drawn as end mills.
         """
         kind = TOOL_TYPES.get(self.tooltype, "endmill")
-        if kind == "endmill" and self.cornerRadius > 0:
+        if self.tooltype == "EndMill" and self.cornerRadius > 0:
             kind = "bullnose"
-        if kind == "bullnose" and self.cornerRadius <= 0:
-            kind = "endmill"
         angle = self.cuttingEdgeAngle if 0 < self.cuttingEdgeAngle < 180 else 0.0
         height = length if length is not None else (self.cuttingEdgeHeight or 30.0)
         return ToolShape(kind, self.diameter, height, corner_radius=self.cornerRadius if kind == "bullnose" else 0.0,

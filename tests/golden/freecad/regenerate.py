@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Regenerate tests/golden/freecad/api.json: FreeCAD 0.20's answers to the scripted API cases (cases.py).
+"""Regenerate tests/golden/freecad/api.json: FreeCAD 0.20's answers to the scripted API cases (freecad_cases.py).
 
 Run with Debian's FreeCAD (``apt-get install freecad-python3``) and its
 interpreter:
@@ -71,7 +71,7 @@ def main():
     import Path
 
     sys.path.insert(0, str(HERE))
-    from cases import CASES
+    from freecad_cases import CASES
 
     def box(p):
         b = p.BoundBox
