@@ -90,7 +90,9 @@ def test_scripted_sequence_gives_freecads_answer(name):
 
 def test_where_freecad_crashes_gcodekit_raises_index_error():
     assert API["cases"]["path_insert_below"].keys() == {"abort"}
-    assert API["cases"]["path_delete_size"].keys() == {"abort"}
+    # erasing at the end is undefined behaviour in FreeCAD: it aborts on a double free, or corrupts
+    # memory and goes on (one regeneration in two here)
+    assert API["cases"]["path_delete_size"].keys() <= {"abort", "result"}
     for name in ("path_insert_below", "path_delete_size"):
         with pytest.raises(IndexError, match="Index not in range"):
             _run(CASES[name])

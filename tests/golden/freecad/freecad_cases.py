@@ -147,7 +147,8 @@ CASES: dict[str, str] = {
 #: Cases where gcodekit answers differently from FreeCAD 0.20 on purpose, and why (docs/freecad.md).
 DIFFERENT: dict[str, str] = {
     "path_insert_below": "FreeCAD 0.20 crashes (a position below -1); gcodekit raises IndexError",
-    "path_delete_size": "FreeCAD 0.20 frees memory twice and crashes; gcodekit raises IndexError",
+    "path_delete_size": "FreeCAD 0.20 erases past the end (undefined: a double-free abort or corrupted memory); "
+                        "gcodekit raises IndexError",
     "command_rounding": "922337203685 overflows FreeCAD's 64-bit arithmetic; gcodekit writes the number",
     "path_inches": "after G20 FreeCAD leaves K unscaled; gcodekit scales it like I and J (here: no K, so the same)",
     "path_splitting": "'G1 X1 ;' keeps FreeCAD's reading; a ';' comment with text is a comment here",
