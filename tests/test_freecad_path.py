@@ -122,6 +122,7 @@ def test_splitting_agrees_and_semicolon_comments_are_comments():
     assert repr(gpath.Path("G1 X1 ; M3 S100\nG1 X2").Commands) == \
         "[Command G1 [ X:1 ], Command (M3 S100) [ ], Command G1 [ X:2 ]]"
     assert gpath.Path("G1 X1 ;5").Commands[0].Parameters == {"X": 1.0}
+    assert gpath.Path("G1 X1 ; a (b) c").Commands[1].Name == "(a [b] c)"  # a comment inside stays one comment
     compat = gpath.Path.from_gcode("G1 X1 ;5", freecad_compatible=True)
     assert compat.Commands[0].Parameters == {"X": 15.0}
 

@@ -38,3 +38,10 @@ def test_a_job_gets_a_report(tmp_path):
     assert row["distance_mm"] == pytest.approx(_job().Path.Length, rel=1e-9)  # 5 + 6 + 20 + 5 pi + 20 + 10 + 6
     page = (tmp_path / row["html"]).read_text()
     assert "pocket" in page and (tmp_path / "pocket.ngc").read_text().startswith("(pocket: post-processed by gcodekit for linuxcnc)")
+
+
+def test_a_report_name_cannot_leave_the_folder(tmp_path):
+    from gcodekit.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="plain file name"):
+        Path.write_report(_job(), tmp_path, name="../escape")

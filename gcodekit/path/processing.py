@@ -200,6 +200,8 @@ def write_report(obj: Pathlike, out_dir: str | os.PathLike, *, name: str = "path
     """
     from ..report.batch import ReportOptions, report_program
 
+    if not name or os.path.basename(name) != name or name.startswith("."):
+        raise ConfigError(f"report name {name!r} must be a plain file name (no folders)")
     out = os.fspath(out_dir)
     os.makedirs(out, exist_ok=True)
     program = os.path.join(out, f"{name}.ngc")

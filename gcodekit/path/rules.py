@@ -218,7 +218,8 @@ def _blank_semicolons(text: str) -> tuple[str, list[tuple[int, str]]]:
             pieces.append(text[last:m.start()])
             pieces.append(" " * len(m.group()))
             last = m.end()
-            comments.append((m.start(), m.group()[1:].strip()))
+            # parentheses would end or nest the '(comment)' it becomes: brackets instead, as FreeCAD's own posts do
+            comments.append((m.start(), m.group()[1:].strip().replace("(", "[").replace(")", "]")))
     pieces.append(text[last:])
     return "".join(pieces), comments
 
@@ -307,9 +308,9 @@ def read_commands(text: str, diagnostics: Diagnostics, *,
             bad = len(part) if freecad else _ALLOWED_IN_COMMAND.match(part).end()
             if bad < len(part):
                 bl, bc = where(start + bad)
-                diagnostics.report(bl, bc, f"{part[bad]!r} is not FreeCAD Path G-code (FreeCAD 0.20 skips it and "
-                                   "reads the digits around it as one number); parameters and expressions "
-                                   "need the pre-processor, gcodekit.path.read()", part.strip()[:60])
+                diagnostics.report(bl, bc, f"{part[bad]!r} is not FreeCAD Path G-code: FreeCAD 0.20 skips it and "
+                                   "misreads the number around it (or aborts on letters after it); parameters "
+                                   "and expressions need the pre-processor, gcodekit.path.read()", part.strip()[:60])
                 continue
             repeated = _repeated_letters(part)
             if repeated:
