@@ -204,6 +204,7 @@ SIGNALS = {
     "gcodekit.preprocess.flow.run.Stop": "ends the program counter's run (a program end or a limit)",
     "gcodekit.preprocess.wizards.arguments.BadCall": "becomes a diagnostic at the call's column",
     "gcodekit.pipeline.feedback.MachineStop": "carries the machine's GcodeError through the parameter stage",
+    "gcodekit.path.rules._Problem": "becomes a FreeCADFormatError or a diagnostic at its column",
 }
 
 
