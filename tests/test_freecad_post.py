@@ -126,3 +126,17 @@ def test_preprocessor_keeps_going_past_what_it_cannot_read():
     path = Path.read("G0 X1\nG1 X2 Y\nG1 X3 F100\n", machine="linuxcnc")
     assert {d.line for d in path.diagnostics.errors} == {2}
     assert path.Commands[-1].Parameters["X"] == 3.0
+
+
+@pytest.mark.parametrize("program, machine", [
+    ("bracket_mill.ngc", "linuxcnc"), ("cube20_prusaslicer_marlin.gcode", None),
+])
+def test_preprocessed_example_measures_what_the_pipeline_measured(program, machine):
+    """read() turns every motion into a command; the path's own length (gcodekit.path.measure, arcs
+    from the written I/J/K) equals the pipeline's distance, so the arcs' centres came across right."""
+    file = FilePath(__file__).resolve().parents[1] / "examples" / program
+    op = gcodekit.gcode_to_operation(file, machine, plan=False)
+    path = Path.read(file, machine=machine)
+    moves = [c for c in path.Commands if c.Name in ("G0", "G1", "G2", "G3")]
+    assert len(moves) == int((op.waypoints["motion"] > 0).sum())
+    assert path.Length == pytest.approx(float(op.waypoints["distance"].sum()), rel=1e-9)
