@@ -395,3 +395,31 @@ def test_freecads_length_and_box_never_exceed_the_exact_box(commands):
         tol = 1e-6 * (1 + max(abs(v) for v in exact.as_list()))
         assert sampled.XMin >= exact.XMin - tol and sampled.XMax <= exact.XMax + tol
         assert sampled.YMin >= exact.YMin - tol and sampled.YMax <= exact.YMax + tol
+
+
+_arc = st.tuples(st.sampled_from(["G2", "G3"]), st.floats(0.5, 20), st.floats(-math.pi, math.pi),
+                 st.floats(0.05, 2 * math.pi - 0.05), st.floats(-5, 5))
+
+
+@given(st.sampled_from(["G17", "G18", "G19"]), st.lists(_arc, min_size=1, max_size=4))
+def test_exact_arc_length_is_the_pipelines(plane, arcs):
+    """Arcs and helices in every plane: Path.Length against gcodekit's emulator (itself checked against rs274)."""
+    a, b, n = {"G17": (0, 1, 2), "G18": (2, 0, 1), "G19": (1, 2, 0)}[plane]
+    pos = [0.0, 0.0, 0.0]
+    commands = [gpath.Command(plane)]
+    for name, r, start, sweep, rise in arcs:
+        centre = list(pos)
+        centre[a] -= r * math.cos(start)
+        centre[b] -= r * math.sin(start)
+        turn = -sweep if name == "G2" else sweep
+        end = list(pos)
+        end[a] = round(centre[a] + r * math.cos(start + turn), 6)
+        end[b] = round(centre[b] + r * math.sin(start + turn), 6)
+        end[n] = round(pos[n] + rise, 6)
+        offsets = {"IJK"[k]: round(centre[k] - pos[k], 6) for k in (a, b)}
+        commands.append(gpath.Command(name, {**dict(zip("XYZ", end)), **offsets, "F": 100.0}))
+        pos = end
+    path = gpath.Path(commands)
+    op = gpath.to_operation(path, plan=False)
+    assert not op.diagnostics.errors, [str(d) for d in op.diagnostics.errors]
+    assert path.Length == pytest.approx(float(op.waypoints["distance"].sum()), rel=1e-6)
