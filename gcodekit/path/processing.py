@@ -56,9 +56,10 @@ Pathlike = Union[Path, "Compound"]
 class Target:
     """What a post-processor writes for one controller.
 
-    ``tool_change`` is how a tool change is written: ``"m6"`` (``T<n> M6``
+    ``tool_change`` is how a tool change is written: ``"m6"`` (``M6 T<n>``
     on one line), ``"pause"`` (spindle off, a comment naming the tool and
-    ``M0``: controllers without a tool changer).
+    ``M0``: controllers without a tool changer).  Without ``canned_cycles``
+    the drilling cycles are written as the moves they make.
     """
 
     flavor: str
@@ -68,16 +69,16 @@ class Target:
     tool_change: str = "m6"
     line_numbers: bool = False
     percent: bool = False  # '%' lines around the program, and an O number
-    program_end: str = "M2"
+    canned_cycles: bool = True
 
 
 #: The post-processors gcodekit has, by name.
 TARGETS: dict[str, Target] = {
     "linuxcnc": Target("rs274ngc", "linuxcnc", ("G21 G90 G17 G40 G80",), ("M5", "M2")),
-    "grbl": Target("grbl", "grbl", ("G21 G90 G17",), ("M5", "M2"), tool_change="pause"),
+    "grbl": Target("grbl", "grbl", ("G21 G90 G17",), ("M5", "M2"), tool_change="pause", canned_cycles=False),
     "fanuc": Target("fanuc", "fanuc", ("G21 G90 G17 G40 G80 G99",), ("M5", "M30"), line_numbers=True, percent=True),
-    "marlin": Target("marlin", "marlin", ("G21", "G90"), ("M5",), tool_change="pause"),
-    "ger": Target("ger", "ger", ("G21 G90 G17",), ("M5", "M2")),
+    "marlin": Target("marlin", "marlin", ("G21", "G90"), ("M5",), tool_change="pause", canned_cycles=False),
+    "ger": Target("ger", "ger", ("G21 G90 G17",), ("M5", "M2"), canned_cycles=False),
 }
 
 
@@ -238,14 +239,12 @@ def post_process(obj: Pathlike, target: str = "linuxcnc", *, header: bool = True
     """
     t = _target(target)
     path = _as_path(obj)
-    if t.flavor != "rs274ngc" and t.flavor != "fanuc":  # no canned cycles there: the moves they make
+    if not t.canned_cycles:
         path = _expand_cycles(path)
     body: list[Command] = []
     for c in path.Commands:
         if c.Name in ("M6", "M06") and t.tool_change == "pause" and c.T is not None:
             body += [Command("M5"), Command(f"(change to tool {int(c.T)})"), Command("M0")]
-        elif c.Name in ("M6", "M06") and c.T is not None:
-            body.append(Command(f"T{int(c.T)} M6"))
         else:
             body.append(c)
     text = Path(body).toGCode()
