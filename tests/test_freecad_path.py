@@ -365,14 +365,18 @@ def test_the_preprocessor_never_crashes_on_the_corpus():
 
 # -- properties -----------------------------------------------------------------------------------
 
-from hypothesis import given  # noqa: E402
+from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
+
+#: no wall-clock limit: the machine is shared and a first call imports modules
+NO_DEADLINE = settings(deadline=None)
 
 _names = st.sampled_from(["G0", "G1", "G2", "G3", "G01", "G38.2", "G81", "M3", "M5", "M6", "G17", "G90", "G91"])
 _values = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False).map(lambda v: round(v, 6))
 _params = st.dictionaries(st.sampled_from(list("ABCFIJKPQRSTXYZ")), _values, max_size=6)
 
 
+@NO_DEADLINE
 @given(st.lists(st.tuples(_names, _params), max_size=12))
 def test_what_topath_writes_reads_back_to_the_same_commands(commands):
     path = gpath.Path([gpath.Command(n, p) for n, p in commands])
@@ -384,6 +388,7 @@ def test_what_topath_writes_reads_back_to_the_same_commands(commands):
     assert again.toGCode() == path.toGCode()
 
 
+@NO_DEADLINE
 @given(st.lists(st.tuples(_names, _params), max_size=12))
 def test_freecads_length_and_box_never_exceed_the_exact_box(commands):
     """FreeCAD's sampled box lies inside the exact one: every sampled point is on the path."""
@@ -401,6 +406,7 @@ _arc = st.tuples(st.sampled_from(["G2", "G3"]), st.floats(0.5, 20), st.floats(-m
                  st.floats(0.05, 2 * math.pi - 0.05), st.floats(-5, 5))
 
 
+@NO_DEADLINE
 @given(st.sampled_from(["G17", "G18", "G19"]), st.lists(_arc, min_size=1, max_size=4))
 def test_exact_arc_length_is_the_pipelines(plane, arcs):
     """Arcs and helices in every plane: Path.Length against gcodekit's emulator (itself checked against rs274)."""
