@@ -30,7 +30,7 @@ from ..parse.table import MOTION_NAMES, CommandTable
 from ..schema import COLUMNS, WAYPOINT_COLUMNS
 from ..syntax.flavor import code_label
 from ..units import MM_PER_INCH
-from . import derived, statistics
+from . import derived, slicer, statistics
 from .process_data import LazyList, ProcessData
 
 if TYPE_CHECKING:
@@ -38,6 +38,7 @@ if TYPE_CHECKING:
 
     from ..emulate.presets import MachineConfig
     from ..syntax import Flavor
+    from .slicer import SlicerFigures
 
 
 #: Columns only a planned operation has
@@ -148,6 +149,13 @@ class Operation:
         return pd.DataFrame({"unit": [c.unit for c in shown], "dtype": [c.dtype for c in shown],
                              "meaning": [c.meaning for c in shown]},
                             index=pd.Index([c.name for c in shown], name="column"))
+
+    def slicer_figures(self) -> "SlicerFigures":
+        """What the slicer wrote into the file: its name, estimated time, filament, layers and progress marks.
+
+        See :mod:`gcodekit.model.slicer`; computed once.
+        """
+        return self._kept("slicer_figures", lambda: slicer.slicer_figures(self))
 
     def summary(self) -> dict[str, Any]:
         """The one summary record (see :func:`gcodekit.model.statistics.summary`)."""
