@@ -273,6 +273,16 @@ class Operation:
 
         return time_by(self, key)
 
+    def slicer_layer_times(self, mode: str = "normal") -> "pd.DataFrame":
+        """Planned time by layer beside the slicer's progress marks (see :func:`gcodekit.analysis.slicer_layer_times`)."""
+        import pandas as pd
+
+        if not self._require_emulation("slicer_layer_times()"):
+            return pd.DataFrame()
+        from ..analysis import slicer_layer_times
+
+        return slicer_layer_times(self, mode)
+
     def velocity_profile(self) -> "pd.DataFrame":
         """Planned and commanded speed over time (see :func:`gcodekit.analysis.velocity_profile`)."""
         import pandas as pd

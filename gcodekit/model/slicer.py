@@ -277,3 +277,30 @@ def _head_text(op: "Operation") -> str:
     """The printer checks among the first commands (``M862.3 P "MK3S"``) as text lines."""
     t = op.table
     return "\n".join(f"M862.3 {t.texts.get(row, '')}" for row in range(min(len(t), 200)) if t.code(row) == "M862.3")
+
+
+#: The figures set beside gcodekit's: (label, key in the summary record, key in the slicer's figures).
+COMPARED = (("time", "time_s", "time_s"), ("filament", "filament_mm", "filament_mm"), ("layers", "layers", "layers"))
+
+
+def compare(record: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """gcodekit's figures beside the slicer's, from a summary record (``op.summary()``).
+
+    Returns one row per figure both sides have: ``figure``, ``gcodekit``,
+    ``slicer`` and ``difference`` (gcodekit's less the slicer's, relative to
+    the slicer's; None when the slicer's is 0).
+
+    Examples
+    --------
+    >>> compare({"time_s": 99.0, "filament_mm": None, "layers": 3, "slicer": {"time_s": 100.0, "layers": 3}})
+    [{'figure': 'time', 'gcodekit': 99.0, 'slicer': 100.0, 'difference': -0.01}, {'figure': 'layers', 'gcodekit': 3, 'slicer': 3, 'difference': 0.0}]
+    """
+    theirs = record.get("slicer") or {}
+    rows = []
+    for label, ours_key, their_key in COMPARED:
+        ours, their = record.get(ours_key), theirs.get(their_key)
+        if ours is None or their is None:
+            continue
+        rows.append({"figure": label, "gcodekit": ours, "slicer": their,
+                     "difference": (ours - their) / their if their else None})
+    return rows

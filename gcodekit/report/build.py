@@ -22,6 +22,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..model.slicer import compare
+
 if TYPE_CHECKING:
     from ..model.operation import Operation
 
@@ -52,7 +54,8 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
     summary["diagnostics"] = [{**d, "elsewhere": Path(d["file"]).name if d["file"] != op.diagnostics.file else ""}
                               for d in summary["diagnostics"][:MAX_DIAGNOSTICS]]
     data: dict[str, Any] = {"name": Path(op.file).name, "summary": summary,
-                            "breakdown": breakdown(op), "layers": None, "stages": None, "toolpath": None}
+                            "breakdown": breakdown(op), "layers": None, "stages": None, "toolpath": None,
+                            "slicer_rows": compare(summary)}
     if additive:
         by_layer = op.time_by("layer")
         by_layer = by_layer[by_layer.index >= 0]
