@@ -82,9 +82,9 @@ def slicer_layer_times(op: "Operation", mode: str = "normal") -> "pd.DataFrame":
     -------
     DataFrame indexed by ``layer`` with ``line`` (the mark's), ``elapsed_s``
     (gcodekit's planned time from the start to the mark), ``slicer_elapsed_s``,
-    ``time_s`` and ``slicer_time_s`` (since the previous compared layer's mark)
-    and ``difference_s`` (``elapsed_s - slicer_elapsed_s``).  Empty when the
-    file has no marks.
+    ``layers`` (how many layers since the previous compared layer), ``time_s``
+    and ``slicer_time_s`` (over those layers) and ``difference_s``
+    (``elapsed_s - slicer_elapsed_s``).  Empty when the file has no marks.
     """
     import pandas as pd
 
@@ -92,7 +92,7 @@ def slicer_layer_times(op: "Operation", mode: str = "normal") -> "pd.DataFrame":
 
     check_choice("mode", mode, ("normal", "silent"))
     marks = [m for m in op.slicer_figures().marks if m.mode == mode]
-    columns = ["line", "elapsed_s", "slicer_elapsed_s", "time_s", "slicer_time_s", "difference_s"]
+    columns = ["line", "elapsed_s", "slicer_elapsed_s", "layers", "time_s", "slicer_time_s", "difference_s"]
     rows_of = waypoint_rows(op)
     elapsed, layer = op.elapsed_time(), op.layers
     by_layer: dict[int, tuple[int, float, float]] = {}
@@ -105,6 +105,7 @@ def slicer_layer_times(op: "Operation", mode: str = "normal") -> "pd.DataFrame":
         return pd.DataFrame(columns=columns, index=pd.Index([], name="layer"))
     frame = pd.DataFrame.from_dict(by_layer, orient="index", columns=columns[:3]).sort_index()
     frame.index.name = "layer"
+    frame["layers"] = np.diff(frame.index.to_numpy(), prepend=-1)
     frame["time_s"] = frame["elapsed_s"].diff().fillna(frame["elapsed_s"])
     frame["slicer_time_s"] = frame["slicer_elapsed_s"].diff().fillna(frame["slicer_elapsed_s"])
     frame["difference_s"] = frame["elapsed_s"] - frame["slicer_elapsed_s"]
