@@ -60,6 +60,19 @@ if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -x /usr/bin/rs274 ]; then
   fi
 fi
 
+# Cura's printer definitions (Debian package cura) are the reference the Creality Ender-3 preset is
+# checked against (tests/test_slicer_figures.py); only the test command asks for them.
+if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -f /usr/share/cura/resources/definitions/creality_base.def.json ]; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    echo "gcodekit setup: installing cura (its printer definitions) with apt-get" >&2
+    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+        cura >/dev/null; } \
+      || die "apt-get could not install cura (Cura's printer definitions, the reference of the Ender-3 preset)"
+  else
+    die "the slicer tests need Cura's printer definitions: install them as root (apt-get install --no-install-recommends cura), then run this again"
+  fi
+fi
+
 want=$(cat "$ROOT/pyproject.toml" | sha256sum | cut -d' ' -f1)
 if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$want" ]; then
   echo "gcodekit setup: installing gcodekit and its test tools into .venv" >&2
