@@ -40,6 +40,7 @@ CURA_FILES = ["cura_ender3_cube20.gcode.gz", "cura_ender3_cylinder.gcode.gz"]
 #: Real files elsewhere whose slicer wrote filament and layers: (folder, name).
 REAL_FILES = [("realworld", "orca_2.3.0b2_k1max_klipper.gcode"), ("realworld", "crealityprint_5.1.4.gcode"),
               ("realworld", "cura_5.9.1_k1max.gcode"), ("realworld", "slic3r_pe_1.36.2_duplo.gcode"),
+              ("realworld", "cura_legacy_fabtotum_cable_ties.gcode"),  # two objects one at a time: 72 + 58 layers
               ("fff", "cube20_marlin2.gcode"), ("fff", "cube20_klipper.gcode"), ("fff", "cylinder_marlin2.gcode"),
               ("fff", "vase_spiral_marlin2.gcode")]
 

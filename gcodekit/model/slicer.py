@@ -10,7 +10,8 @@ them, so that gcodekit's figures can be set beside the slicer's.
 Recognised: PrusaSlicer, SuperSlicer, Slic3r (Prusa edition), OrcaSlicer,
 Bambu Studio and Creality Print (``; name = value`` headers, footers and
 configuration block), CuraEngine 4 and 5 (``;TIME:``, ``;Filament used:``,
-``;LAYER_COUNT:``) and the Cura 15 legacy header.  Only the comments near the
+``;LAYER_COUNT:``, one per object when they are printed one at a time) and
+the Cura 15 legacy header.  Only the comments near the
 start and the end of the file are read, and the progress marks wherever they
 are.
 
@@ -50,6 +51,8 @@ _BANNERS = (
      None),
     (re.compile(r"^(BambuStudio)\s+(\S+)$"), None),
     (re.compile(r"^Generated with Cura_SteamEngine\s+(\S+)"), "CuraEngine"),
+    # the Cura 15 legacy engine names no version: ";Sliced at: Thu 25-05-2017 10:25:01"
+    (re.compile(r"^Sliced at: \w+ \d\d-\d\d-\d{4} \d\d:\d\d"), "Cura (legacy)"),
 )
 _NAMES = {"creality_print": "Creality Print", "bambustudio": "BambuStudio"}
 # "; key = value" (the Slic3r family) and ";KEY:value" (Cura)
@@ -57,6 +60,8 @@ _SETTING = re.compile(r"^([A-Za-z_][\w .\[\]()]*?)\s*(?:=|:)\s*(.*)$")
 _DURATION = re.compile(r"(?:(\d+)d)?\s*(?:(\d+)h)?\s*(?:(\d+)m(?!m))?\s*(?:([\d.]+)s)?")
 _NUMBER = re.compile(r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?")
 _ELAPSED = re.compile(rb"TIME_ELAPSED:\s*([-+]?\d*\.?\d+)")
+# Cura writes one per object when it prints them one at a time
+_CURA_LAYER_COUNT = re.compile(rb"(?:LAYER_COUNT|Layer count):\s*(\d+)")
 
 
 def parse_duration(text: str) -> float | None:
@@ -231,7 +236,7 @@ def slicer_figures(op: "Operation") -> SlicerFigures:
                 m = pattern.search(text)
                 if m:
                     values["slicer"] = name or _NAMES.get(m[1].lower(), m[1])
-                    values["version"] = m[m.lastindex]
+                    values["version"] = m[m.lastindex] if m.lastindex else None
                     break
         m = _SETTING.match(text)
         if m:
@@ -256,8 +261,10 @@ def slicer_figures(op: "Operation") -> SlicerFigures:
         m = re.match(r"\s*([\d.]+)mm(?:\s*\(([\d.]+)cm3\))?", get("filament used", ""))
         if m:
             filament_mm, cm3 = float(m[1]), float(m[2]) if m[2] else cm3
-    layers = next((int(float(get(k))) for k in ("LAYER_COUNT", "total layer number", "total layers count",
-                                                "Layer count") if get(k) and _NUMBER.fullmatch(get(k))), None)
+    layers = next((int(float(get(k))) for k in ("total layer number", "total layers count")
+                   if get(k) and _NUMBER.fullmatch(get(k))), None)
+    if layers is None and (get("LAYER_COUNT") or get("Layer count")):
+        layers = sum(int(v) for v in _CURA_LAYER_COUNT.findall(op.table.comment_data))
     printer = get("printer_model") or get("TARGET_MACHINE.NAME") or None
     if printer is None:
         check = re.search(r'^M862\.3 P\s*"?([^"\s;]+)', _head_text(op), re.M)
