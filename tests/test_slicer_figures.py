@@ -2,7 +2,7 @@
 
 References, all independent of gcodekit:
 
-- ``tests/golden/slicers/``: files made here by ``regenerate.py`` with
+- ``tests/golden/slicers/``: files made here by ``make_slicer_files.py`` with
   PrusaSlicer 2.5 (an MK3S, normal and silent mode, M73 marks) and CuraEngine
   4.13 with the Creality Ender-3 definitions of Debian's ``cura`` package (the
   header is the one the engine logs, as Cura's front end writes it);

@@ -2,7 +2,7 @@
 """Make the slicer files of tests/golden/slicers/ with the slicers Debian packages.
 
     apt-get install --no-install-recommends prusa-slicer cura-engine cura
-    python3 tests/golden/slicers/regenerate.py
+    python3 tests/golden/slicers/make_slicer_files.py
 
 Two shapes (a 20 mm cube and a 20 mm x 10 mm cylinder of 96 facets), written
 here as binary STL, are sliced by
