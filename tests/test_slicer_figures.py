@@ -178,11 +178,12 @@ def test_time_by_layer_against_curas_marks(golden):
 
 def test_time_by_layer_against_prusaslicers_marks(golden):
     op = golden["prusa_mk3s_cube20.gcode.gz"]
-    for mode in ("normal", "silent"):
+    for mode, within in (("normal", 0.01), ("silent", 0.02)):  # gcodekit plans the normal mode's limits
         table = op.slicer_layer_times(mode)
         assert len(table) > 10 and table["layers"].sum() == table.index[-1] + 1
-        # M73 carries whole minutes: the slicer's elapsed time is known to a minute
-        assert (table["difference_s"].abs() < 60 + 0.02 * table["slicer_elapsed_s"]).all()
+        # each mark is where the whole percent or the whole minutes left change: its time is known to a
+        # few seconds, and gcodekit's plan stays that close all the way through
+        assert (table["difference_s"].abs() < 5 + within * table["slicer_elapsed_s"]).all(), mode
 
 
 # -- presets from what the file says --------------------------------------------------------------------

@@ -110,7 +110,10 @@ class Mark:
         Progress, % (M73 P or Q).
     elapsed_s : float
         Time since the print started by the slicer's estimate, s: Cura's
-        ``;TIME_ELAPSED:``, or the estimate less M73's remaining minutes.
+        ``;TIME_ELAPSED:``; from M73, the larger of ``total * P / 100`` and
+        ``total - 60 (R + 1)``.  PrusaSlicer writes P (whole percent done)
+        and R (whole minutes left), both rounded down, where either changes,
+        so at each mark the one that changed makes this exact.
     remaining_s : float or None
         M73 R or S in seconds (whole minutes as written); None for Cura.
     """
@@ -221,8 +224,12 @@ def _progress_marks(op: "Operation", time_s: float | None, time_silent_s: float 
             percent, remaining = cols[pc][j], cols[rc][j]
             if np.isnan(remaining) or total is None:
                 continue
+            # R is the whole minutes left rounded down and P the whole percent done rounded down; a mark is
+            # written where one of them changes, so there the larger of the two lower bounds is exact
+            done = total * float(percent) / 100.0 if not np.isnan(percent) else 0.0
+            elapsed = min(max(done, total - 60.0 * (float(remaining) + 1.0), 0.0), total)
             marks.append(Mark(int(t.line[row]), row, mode, None if np.isnan(percent) else float(percent),
-                              max(total - 60.0 * float(remaining), 0.0), 60.0 * float(remaining)))
+                              elapsed, 60.0 * float(remaining)))
     return marks
 
 
