@@ -228,8 +228,18 @@ def test_ender3_preset_is_curas_definition():
     assert (p["max_jerk_z"], p["max_jerk_e"]) == (overrides["machine_max_jerk_z"], overrides["machine_max_jerk_e"])
     assert overrides["acceleration_enabled"] is False  # so Cura estimates with machine_acceleration
     assert p["acceleration"] == p["travel_acceleration"] == overrides["machine_acceleration"]
-    assert overrides["machine_name"] == "Creality Ender-3" and "Creality Ender-3" in load_machine(
-        "creality_ender3").printer_names
+    assert overrides["machine_name"] == "Creality Ender-3"
+    # each printer the preset names is a Cura definition on creality_base with no limits of its own
+    defined = {}
+    for path in CURA_DEFINITIONS.glob("creality_*.def.json"):
+        data = json.loads(path.read_text())
+        defined[data["overrides"].get("machine_name", {}).get("default_value")] = data
+    for name in load_machine("creality_ender3").printer_names:
+        data = defined[name]
+        while data.get("inherits") != "creality_base":
+            data = json.loads((CURA_DEFINITIONS / f"{data['inherits']}.def.json").read_text())
+            assert not any(k.startswith("machine_max") or k == "machine_acceleration" for k in data["overrides"])
+        assert not any(k.startswith("machine_max") or k == "machine_acceleration" for k in defined[name]["overrides"])
 
 
 def test_machine_chosen_from_the_printer_a_cura_5_file_names():
