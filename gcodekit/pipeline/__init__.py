@@ -138,7 +138,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         settings = planner_settings(config.planner, config.planner_settings, machine_config)
         if config.planner == "marlin" and machine_config is None:
             settings = _with_slicer_limits(op, settings)
-        run_planner(op, config.planner, settings)
+        op.attach_plan(run_planner(op, config.planner, settings))
     restore_line_numbers(op.table, diagnostics)
     quote_diagnostics(op.diagnostics, program)
     return op
