@@ -2,7 +2,7 @@
 # Create .venv and install gcodekit with its test and report tools, once per
 # change of pyproject.toml; install Chromium (PDF reports) and poppler-utils
 # (the PDF test) with apt-get when missing, and for the tests LinuxCNC's rs274
-# (the differential check against it).  Sourced by run-examples.sh and
+# (the differential check against it) and Cura's printer definitions.  Sourced by run-examples.sh and
 # run-tests.sh (which sets GCODEKIT_SETUP_RS274=1).
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -60,10 +60,7 @@ fi
 # checked against (tests/test_slicer_figures.py); only the test command asks for them.
 if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -f /usr/share/cura/resources/definitions/creality_base.def.json ]; then
   if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
-    echo "gcodekit setup: installing cura (its printer definitions) with apt-get" >&2
-    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-        cura >/dev/null; } \
-      || die "apt-get could not install cura (Cura's printer definitions, the reference of the Ender-3 preset)"
+    apt_install "Cura's printer definitions, the reference of the Ender-3 preset" --no-install-recommends cura
   else
     die "the slicer tests need Cura's printer definitions: install them as root (apt-get install --no-install-recommends cura), then run this again"
   fi
