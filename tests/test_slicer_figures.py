@@ -15,6 +15,7 @@ References, all independent of gcodekit:
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import gzip
 import json
@@ -321,3 +322,19 @@ def test_report_summary_has_the_slicers_figures():
     assert figures["time"]["difference"] == pytest.approx(
         (op.get_statistics()["time_s"] - op.slicer_figures().time_s) / op.slicer_figures().time_s)
     assert data["slicer_layers"] and data["slicer_layers"][-1]["slicer_elapsed_s"] == op.slicer_figures().time_s
+
+
+def test_report_page_row_says_what_the_slicer_says_escaped():
+    from gcodekit.report.html import program_page
+
+    text = text_of(GOLDEN / "cura_ender3_cube20.gcode.gz").replace(
+        ";Generated with Cura_SteamEngine 4.13.0", ";Generated with Cura_SteamEngine <b>4.13</b>", 1)
+    op = gcodekit.gcode_to_operation(text, "creality_ender3")
+    from gcodekit.report.build import report_data
+
+    page = program_page(report_data(op), collections.defaultdict(lambda: None))  # no pictures needed here
+    row = re.search(r"<th>Slicer says</th><td>(.*?)</td>", page)[1]
+    assert row.startswith("CuraEngine &lt;b&gt;4.13&lt;/b&gt;:") and "<b>4.13" not in page
+    ours = op.get_statistics()["time_s"]
+    assert f"time 0:31:35 (gcodekit {100 * (ours - 1895) / 1895:+.1f} %)" in row
+    assert "layers 100 (gcodekit the same)" in row
