@@ -338,3 +338,16 @@ def test_report_page_row_says_what_the_slicer_says_escaped():
     ours = op.get_statistics()["time_s"]
     assert f"time 0:31:35 (gcodekit {100 * (ours - 1895) / 1895:+.1f} %)" in row
     assert "layers 100 (gcodekit the same)" in row
+
+
+def test_figures_of_bambu_studio_and_creality_print_headers():
+    bambu = gcodekit.gcode_to_operation(shared_file("realworld", "bambustudio_1.7.6_x1_cube.gcode"), plan=False)
+    f = bambu.slicer_figures()
+    # "; model printing time: 8m 57s; total estimated time: 15m 42s" and "; total layer number: 92"
+    assert (f.slicer, f.version, f.time_s, f.layers) == ("BambuStudio", "01.07.06.92", 15 * 60 + 42, 92)
+    assert f.filament_mm is None  # Bambu Studio 1.7 writes no filament figure
+    creality = gcodekit.gcode_to_operation(shared_file("realworld", "crealityprint_5.1.4.gcode"), plan=False)
+    f = creality.slicer_figures()
+    # "; filament cost = 0.65; total filament used [g] = 32.46" is two settings on one line
+    assert (f.slicer, f.filament_g, f.filament_cost, f.layers) == ("Creality Print", 32.46, 0.65, 20)
+    assert f.time_s == 39 * 60 + 45  # "estimated printing time (normal mode) = 39m 45s"

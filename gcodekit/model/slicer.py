@@ -57,6 +57,9 @@ _BANNERS = (
 _NAMES = {"creality_print": "Creality Print", "bambustudio": "BambuStudio"}
 # "; key = value" (the Slic3r family) and ";KEY:value" (Cura)
 _SETTING = re.compile(r"^([A-Za-z_][\w .\[\]()]*?)\s*(?:=|:)\s*(.*)$")
+# several on one comment: Bambu's "model printing time: 8m 57s; total estimated time: 15m 42s",
+# Creality Print's "filament cost = 0.65; total filament used [g] = 32.46" (not "#ffffff;#000000")
+_SEVERAL = re.compile(r";\s*(?=[A-Za-z_][\w .\[\]()]*?\s*[=:])")
 _DURATION = re.compile(r"(?:(\d+)d)?\s*(?:(\d+)h)?\s*(?:(\d+)m(?!m))?\s*(?:([\d.]+)s)?")
 _NUMBER = re.compile(r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?")
 _ELAPSED = re.compile(rb"TIME_ELAPSED:\s*([-+]?\d*\.?\d+)")
@@ -181,18 +184,13 @@ class SlicerFigures:
                          "remaining_s": m.remaining_s} for m in self.marks]
         return out
 
-    def setting(self, key: str, index: int = 0) -> float | None:
-        """A numeric setting, the ``index``-th of a per-mode or per-extruder list (``"1000,960"``)."""
-        values = _numbers(self.settings.get(key, ""))
-        return values[index] if len(values) > index else None
 
-
-def _comment_texts(op: "Operation") -> list[tuple[int, str]]:
-    """(row, text) of the comments near both ends of the file."""
+def _comment_texts(op: "Operation") -> list[str]:
+    """The comments near both ends of the file."""
     t = op.table
     n = t.comment_rows.size
     ks = list(range(min(n, HEAD_COMMENTS))) + list(range(max(HEAD_COMMENTS, n - TAIL_COMMENTS), n))
-    return [(int(t.comment_rows[k]), t.comment(k)) for k in ks]
+    return [t.comment(k) for k in ks]
 
 
 def _elapsed_marks(op: "Operation") -> list[Mark]:
@@ -237,7 +235,7 @@ def slicer_figures(op: "Operation") -> SlicerFigures:
     """Read the slicer's figures from a program's comments (see the module docstring)."""
     values: dict[str, Any] = {}
     settings: dict[str, str] = {}
-    for row, text in _comment_texts(op):
+    for text in _comment_texts(op):
         if "slicer" not in values:
             for pattern, name in _BANNERS:
                 m = pattern.search(text)
@@ -245,13 +243,10 @@ def slicer_figures(op: "Operation") -> SlicerFigures:
                     values["slicer"] = name or _NAMES.get(m[1].lower(), m[1])
                     values["version"] = m[m.lastindex] if m.lastindex else None
                     break
-        m = _SETTING.match(text)
-        if m:
-            settings.setdefault(m[1].strip(), m[2].strip())
-        if text.startswith("model printing time:"):  # Bambu: "...; total estimated time: 15m 42s"
-            for part in text.split(";"):
-                key, _, value = part.partition(":")
-                settings.setdefault(key.strip(), value.strip())
+        for part in _SEVERAL.split(text):
+            m = _SETTING.match(part)
+            if m:
+                settings.setdefault(m[1].strip(), m[2].strip())
     get = settings.get
     time_s = next((parse_duration(get(k)) for k in ("estimated printing time (normal mode)", "total estimated time",
                                                     "TIME", "Print time") if get(k)), None)
