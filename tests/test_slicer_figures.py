@@ -152,7 +152,8 @@ def test_cura_time_gap_is_its_xy_jerk_rule(golden, name):
     op = golden[name]
     cura_s = op.slicer_figures().time_s
     firmware_s = op.get_statistics()["time_s"]
-    assert op.machine.name == "marlin"  # Cura 4 names no printer: chosen by --machine
+    assert op.machine.name == "marlin"  # Cura 4 names no printer: chosen by --machine, as an info says
+    assert any("wrote no machine limits" in d.message and d.severity == "info" for d in op.diagnostics)
     ender = load_machine("creality_ender3")
     as_firmware = gcodekit.gcode_to_operation(GOLDEN / name, ender).get_statistics()["time_s"]
     vector_jerk = dict(ender.planner_settings, max_jerk_x=10 / np.sqrt(2), max_jerk_y=10 / np.sqrt(2))
