@@ -35,7 +35,7 @@ from ..plan import machine_options as firmware_options
 from ..plan import planner_settings, run_planner
 from ..read import Blocks
 from ..syntax import Flavor
-from .assemble import concat_waypoints, empty_table, new_machine, raise_first_run
+from .assemble import concat_waypoints, empty_table, new_machine, raise_first_run, warn_implausible_time
 from .program import Program, as_program, check_program_end, note_weak_detection, progress_bar, quote_diagnostics, resolve
 from .source import program_blocks, restore_line_numbers
 
@@ -139,6 +139,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         if config.planner == "marlin" and machine_config is None:
             settings = _with_slicer_limits(op, settings, chosen=machine is not None)
         op.attach_plan(run_planner(op, config.planner, settings))
+    warn_implausible_time(op)
     restore_line_numbers(op.table, diagnostics)
     quote_diagnostics(op.diagnostics, program)
     return op
