@@ -54,6 +54,12 @@ class ProgramCheck(Check):
     operation: "Operation | None" = field(default=None, repr=False)
     failed: list[str] = field(default_factory=list)
 
+    def view(self, **options):
+        """The program in a :class:`~gcodekit.widgets.LayerViewer` (a message in it when there is none to draw)."""
+        from .layer_viewer import LayerViewer
+
+        return LayerViewer(self.operation if self.operation is not None else "", **options)
+
 
 def check_program(program: str | None, requirements: Sequence[Requirement], machine: str | None = None,
                   **options) -> ProgramCheck:
@@ -77,7 +83,7 @@ def check_program(program: str | None, requirements: Sequence[Requirement], mach
         op = gcode_to_operation(str(program), machine, **options)
     except Exception as exc:  # a program gcodekit refuses: say why, with its line
         return ProgramCheck(False, f"Not yet: gcodekit cannot run your program: {exc}")
-    errors = [str(d).replace("<string>:", "line ", 1) for d in op.diagnostics.errors()]
+    errors = [str(d).replace("<string>:", "line ", 1) for d in op.diagnostics.errors]
     if errors:
         return ProgramCheck(False, "Not yet: the controller would stop at an error in your program:\n- "
                             + "\n- ".join(errors[:3]), op, ["runs without errors"])
@@ -175,13 +181,25 @@ def passes_through(points: Sequence[Sequence[float]], *, cutting: bool = True, t
     kinds = (FEED, ARC_CW, ARC_CCW) if cutting else (RAPID, FEED, ARC_CW, ARC_CCW)
 
     def test(op, source):
-        path = path_points(op, kinds)
-        missed = [p for p in points if path.size == 0 or np.min(np.linalg.norm(path - np.asarray(p, float), axis=1))
-                  > tolerance]
+        from .toolpath import _segments
+
+        rows = _moves(op, kinds)
+        missed = list(points)
+        if rows.size:
+            start, end, _ = _segments(op.waypoints, rows)
+            missed = [p for p in points if _distance_to_segments(np.asarray(p, float), start, end) > tolerance]
         return ("the cut never reaches " if cutting else "the tool never reaches ") \
             + ", ".join(_xyz(p) for p in missed) if missed else None
 
     return Requirement(("cuts through " if cutting else "goes through ") + ", ".join(_xyz(p) for p in points), test)
+
+
+def _distance_to_segments(point: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
+    """The shortest distance from ``point`` to the segments ``start[k]``-``end[k]``."""
+    d = end - start
+    length2 = np.einsum("ij,ij->i", d, d)
+    t = np.clip(np.einsum("ij,ij->i", point - start, d) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
+    return float(np.min(np.linalg.norm(start + t[:, None] * d - point, axis=1)))
 
 
 def on_circle(center: Sequence[float], radius: float, z: float, *, turn: str = "cw",
