@@ -386,6 +386,19 @@ def feed_at_most(feed: float) -> Requirement:
     return Requirement(f"no feed above F{feed:g}", test)
 
 
+def prints_at_least(feed: float) -> Requirement:
+    """Every move that lays material runs at ``feed`` (mm/min) or faster."""
+
+    def test(op, source):
+        w = op.waypoints
+        laying = np.flatnonzero((np.asarray(w["distance"], float) > 0) & (np.asarray(w["de"], float) > 0))
+        f = np.asarray(w["feed"], float)[laying]
+        slow = laying[f < feed - 1e-9]
+        return f"line {_line(op, slow[0])} prints at F{float(w['feed'][slow[0]]):g}" if slow.size else None
+
+    return Requirement(f"every printed move at F{feed:g} or faster", test)
+
+
 def visits_in_order(points: Sequence[Sequence[float]], *, tolerance: float = 0.01) -> Requirement:
     """The moves end at each of these XY points, in this order (other points may come between)."""
 
@@ -436,7 +449,7 @@ def retracts(length: float, *, tolerance: float = 0.01) -> Requirement:
             forth = de[row + 1:prints[prints > row].min()]
             if abs(back[back < 0].sum() + length) > tolerance:
                 problems.append(f"before the travel on line {_line(op, row)} the filament is pulled back "
-                                f"{-back[back < 0].sum():.3g} mm")
+                                f"{abs(back[back < 0].sum()):.3g} mm")
             if abs(forth[forth > 0].sum() - length) > tolerance:
                 problems.append(f"after the travel on line {_line(op, row)} it is pushed back "
                                 f"{forth[forth > 0].sum():.3g} mm")
