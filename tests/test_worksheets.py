@@ -105,9 +105,9 @@ WRONG_PROGRAMS = {
         (lambda: _edit("02-arcs-planes-helices", 3, "P3", "P2"), "it makes 2 turns"),
     ],
     ("03-tools-and-length-offsets", 2): [
-        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H2", "G43 H1"), "tool 2's tip goes down to Z-17"),
-        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H2", "G49"), "tool 2's tip goes down to Z-42"),
-        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H1", "G43 H2"), "tool 1's tip goes down to Z13"),
+        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H2", "G43 H1"), "tool 2's tip goes deeper than Z-2"),
+        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H2", "G49"), "tool 2's tip goes deeper than Z-2"),
+        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H1", "G43 H2"), "tool 1's tip goes not as deep as Z-2"),
     ],
     ("04-canned-cycles", 2): [
         (lambda: _edit("04-canned-cycles", 2, "G98 X30", "X30"), "the tool passes over it at Z1"),
@@ -295,10 +295,22 @@ def course(tmp_path_factory):
     ``right`` hands in the teacher's answers, ``empty`` the released worksheets as they are, ``wrong`` a wrong
     answer (the first wrong program) in every exercise.
     """
+    import sys
+
     from nbgrader.apps import NbGraderAPI
     from traitlets.config import Config
 
-    root = tmp_path_factory.mktemp("course")
+    # nbgrader runs its `alembic` command by name: this environment's scripts first on the path
+    path = os.environ["PATH"]
+    os.environ["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{path}"
+    try:
+        yield _graded_course(tmp_path_factory.mktemp("course"), NbGraderAPI, Config)
+    finally:
+        os.environ["PATH"] = path
+
+
+def _graded_course(root: Path, NbGraderAPI, Config):
+    """The course of the fixture above, graded: (root, scores)."""
     source = root / "source" / "worksheets"
     shutil.copytree(WORKSHEETS, source, ignore=shutil.ignore_patterns("README.md", "nbgrader_config.py", "*.html"))
     shutil.copy(WORKSHEETS / "nbgrader_config.py", root / "nbgrader_config.py")
@@ -390,3 +402,80 @@ def test_autograded_notebooks_run_to_the_end_and_feedback_keeps_answers_hidden(c
                 assert not _holds(said, value), (name, k, said)
             page = (root / "feedback" / student / "worksheets" / f"{name}.html").read_text()
             assert "Not quite" in page or "Not yet" in page
+
+
+# -- handing in as HTML ------------------------------------------------------------------------------------------
+
+WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
+_REMOTE_SCRIPT = re.compile(r"<script[^>]*\ssrc=[\"']?(https?:)?//", re.I)
+
+
+@pytest.fixture(scope="module")
+def handed_in(course, tmp_path_factory):
+    """The right hand-ins as nbgrader executed them, converted by plain ``jupyter nbconvert --to html``."""
+    import subprocess
+    import sys
+
+    root, _ = course
+    folder = tmp_path_factory.mktemp("hand-in")
+    for name in NAMES:
+        shutil.copy(root / "autograded" / "right" / "worksheets" / f"{name}.ipynb", folder)
+    jupyter = Path(sys.executable).parent / "jupyter"
+    done = subprocess.run([str(jupyter), "nbconvert", "--to", "html", *[f"{n}.ipynb" for n in NAMES]], cwd=folder,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return folder
+
+
+def _widget_outputs(nb) -> int:
+    return sum(WIDGET_VIEW in o.get("data", {}) for c in nb.cells if c.cell_type == "code" for o in c.outputs)
+
+
+def test_plain_nbconvert_shows_one_picture_per_widget_and_no_remote_script(handed_in):
+    for name in NAMES:
+        nb = nbformat.read(handed_in / f"{name}.ipynb", as_version=4)
+        page = (handed_in / f"{name}.html").read_text()
+        widgets = _widget_outputs(nb)
+        assert widgets > 0, name
+        pictures = len(re.findall(r'<img[^>]+src="data:image/png;base64,', page))
+        assert pictures == widgets, (name, pictures, widgets)
+        assert not _REMOTE_SCRIPT.search(page), (name, _REMOTE_SCRIPT.search(page))
+        assert WIDGET_VIEW not in page and "html-manager" not in page
+
+
+def test_handed_in_pages_show_their_pictures_offline_in_chromium(handed_in):
+    from jupyter_browser import browser_page, chromium_path
+
+    if chromium_path() is None:
+        pytest.skip("chromium not found: apt-get install chromium (scripts/setup.sh does as root)")
+    import numpy as np
+    from PIL import Image
+
+    with browser_page() as page:
+        page.context.set_offline(True)
+        for name in NAMES:
+            page.goto((handed_in / f"{name}.html").as_uri())
+            page.wait_for_load_state("load")
+            sizes = page.evaluate("[...document.images].map(i => [i.naturalWidth, i.naturalHeight])")
+            assert sizes and all(w > 100 and h > 100 for w, h in sizes), (name, sizes)
+            # looked at as a picture: the first widget's picture as the page shows it holds a drawing, not a blank
+            shot = page.locator("img").first.screenshot()
+            pixels = np.asarray(Image.open(io.BytesIO(shot)).convert("L"), float)
+            assert pixels.std() > 10 and (pixels < 128).mean() > 0.005, name
+        assert page.console_errors == []
+
+
+def test_jupyterlab_export_shows_the_pictures_offline(handed_in, tmp_path):
+    """JupyterLab's File > Save and Export Notebook As > HTML asks the server's /nbconvert/html handler."""
+    import urllib.request
+
+    from jupyter_browser import jupyter_lab
+
+    name = "06-cutter-compensation-and-stages"
+    shutil.copy(handed_in / f"{name}.ipynb", tmp_path)
+    with jupyter_lab(tmp_path) as url:
+        with urllib.request.urlopen(f"{url}/nbconvert/html/{name}.ipynb?download=true", timeout=120) as r:
+            page = r.read().decode()
+    nb = nbformat.read(tmp_path / f"{name}.ipynb", as_version=4)
+    assert len(re.findall(r'<img[^>]+src="data:image/png;base64,', page)) == _widget_outputs(nb)
+    assert not _REMOTE_SCRIPT.search(page) and WIDGET_VIEW not in page

@@ -276,8 +276,9 @@ def tip_depth(depth: float, tool_lengths: dict[int, float], *, tolerance: float 
                 wrong.append(f"tool {number} never cuts")
                 continue
             lowest = float(mine.min()) - length
-            if abs(lowest - depth) > tolerance:
-                wrong.append(f"tool {number}'s tip goes down to Z{lowest:.4g}")
+            if abs(lowest - depth) > tolerance:  # said without the depth: that is another exercise's answer
+                wrong.append(f"tool {number}'s tip goes {'deeper than' if lowest < depth else 'not as deep as'} "
+                             f"Z{depth:g}")
         return "; ".join(wrong) or None
 
     return Requirement(f"the tip of each tool ({', '.join(f'T{t}' for t in tool_lengths)}) cuts down to Z{depth:g}",
