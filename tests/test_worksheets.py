@@ -285,6 +285,15 @@ def test_zigzag_length_stated_in_worksheet_7():
     assert "437.24 mm" in " ".join(c.source for c in _cells("07-planned-against-naive-time"))
 
 
+def test_layer_times_stated_in_worksheet_9():
+    import gcodekit
+
+    op = gcodekit.gcode_to_operation(str(WORKSHEETS / "programs" / "cube20_prusaslicer_marlin.gcode"))
+    times = gcodekit.AdditivePart(op).layer_times().time
+    assert times.idxmax() == 0 and round(times.max()) == 65
+    assert 20 < times.idxmin() < 80 and round(times.min()) == 11
+
+
 # -- nbgrader ------------------------------------------------------------------------------------------------------
 
 
