@@ -337,8 +337,13 @@ def inside_box(box: Sequence[float], z_below: float, *, tolerance: float = 0.01)
         x0, y0, x1, y1 = box
         out = low[(low[:, 0] < x0 - tolerance) | (low[:, 0] > x1 + tolerance) | (low[:, 1] < y0 - tolerance)
                   | (low[:, 1] > y1 + tolerance)]
-        return f"the tool centre goes to X{out[0, 0]:.4g} Y{out[0, 1]:.4g} at Z{out[0, 2]:.4g}, outside" \
-            if out.size else None
+        if not out.size:
+            return None
+        rows = _moves(op, (RAPID, FEED, ARC_CW, ARC_CCW))
+        xyz = np.column_stack([np.asarray(op.waypoints[k], float)[rows] for k in "xyz"])
+        first = rows[np.flatnonzero(np.all(np.isclose(xyz[:, None, :], out[None, :, :]), axis=2).any(axis=1))]
+        where = f" on line {_line(op, first[0])}" if first.size else ""
+        return f"the tool centre leaves the box{where}"  # no coordinates: they could answer another exercise
 
     return Requirement(f"below Z{z_below:g} the tool centre stays within X{box[0]:g}..{box[2]:g} "
                        f"Y{box[1]:g}..{box[3]:g}", test)
