@@ -486,8 +486,9 @@ def test_jupyterlab_export_shows_the_pictures_offline(handed_in, tmp_path):
     name = "06-cutter-compensation-and-stages"
     shutil.copy(handed_in / f"{name}.ipynb", tmp_path)
     with jupyter_lab(tmp_path) as url, browser_page() as page:
-        page.goto(f"{url}/lab")  # the session JupyterLab's menu asks with
-        response = page.request.get(f"{url}/nbconvert/html/{name}.ipynb?download=true")
+        page.goto(f"{url}/lab")
+        # what the menu item opens: the server's exporter, asked from the JupyterLab page
+        response = page.request.get(f"{url}/nbconvert/html/{name}.ipynb?download=true", headers={"Referer": f"{url}/lab"})
         assert response.ok, response.status
         page_html = response.text()
     nb = nbformat.read(tmp_path / f"{name}.ipynb", as_version=4)
