@@ -11,7 +11,6 @@ and what the program did instead.
 
 Examples
 --------
->>> square = [(0, 0), (10, 0), (10, 10), (0, 10)]
 >>> check_program("G21 G90\\nM3 S1000\\nG1 X10 F100\\nM2\\n", [spindle_on_before_cutting()], "linuxcnc").ok
 True
 >>> check_program("G21 G90\\nG1 X10 F100\\nM3 S1000\\nM2\\n", [spindle_on_before_cutting()], "linuxcnc")
@@ -47,7 +46,7 @@ class Requirement:
     test: Callable[["Operation", str], str | None]
 
 
-@dataclass
+@dataclass(repr=False)
 class ProgramCheck(Check):
     """A :class:`Check` of a program, with the emulated operation (None when it could not be read)."""
 
