@@ -120,7 +120,9 @@ def test_plain_nbconvert_shows_widget_pictures_where_the_wheel_is_installed(inst
                                                                            "state": state}}
     nbformat.write(nb, tmp_path / "handin.ipynb")
     done = subprocess.run([str(python), "-m", "nbconvert", "--to", "html", "handin.ipynb"], cwd=tmp_path,
-                          capture_output=True, text=True, env={**os.environ, "PYTHONNOUSERSITE": "1"})
+                          capture_output=True, text=True,
+                          # nbconvert's templates are data of the borrowed environment; its config is the wheel's
+                          env={**os.environ, "PYTHONNOUSERSITE": "1", "JUPYTER_PATH": f"{sys.prefix}/share/jupyter"})
     assert done.returncode == 0, done.stderr
     page = (tmp_path / "handin.html").read_text()
     assert page.count('src="data:image/png;base64,') == 1
