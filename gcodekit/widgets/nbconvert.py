@@ -18,11 +18,14 @@ gcodekit widgets convert as before.
 
 from __future__ import annotations
 
+import re
+
 from nbconvert.preprocessors import Preprocessor
 
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 #: Stands in for a script address: loads nothing and fails nothing.
 NO_SCRIPT = "data:text/javascript,"
+_CODE = re.compile(r"```.*?```|`[^`]*`", re.S)
 #: The preprocessor's import path, as nbconvert's configuration names it.
 PREPROCESSOR = "gcodekit.widgets.nbconvert.WidgetPictures"
 
@@ -48,8 +51,8 @@ class WidgetPictures(Preprocessor):
         if pictures and not views:
             nb.metadata.pop("widgets", None)  # no widget manager to load: the pictures stand in for the views
             resources["require_js_url"] = NO_SCRIPT
-            if not any("$" in cell.source for cell in nb.cells if cell.cell_type == "markdown"):
-                resources["mathjax_url"] = NO_SCRIPT  # no mathematics to typeset
+            if not any("$" in _CODE.sub("", cell.source) for cell in nb.cells if cell.cell_type == "markdown"):
+                resources["mathjax_url"] = NO_SCRIPT  # no mathematics to typeset (a $ in code is not one)
         return nb, resources
 
 

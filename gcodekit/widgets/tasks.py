@@ -175,8 +175,13 @@ def rapids_above(z: float) -> Requirement:
     return Requirement(f"no rapid move below Z{z:g}", test)
 
 
-def passes_through(points: Sequence[Sequence[float]], *, cutting: bool = True, tolerance: float = 0.01) -> Requirement:
-    """The feed moves (or, with ``cutting=False``, any moves) pass through each point (machine X, Y, Z)."""
+def passes_through(points: Sequence[Sequence[float]], *, cutting: bool = True, tolerance: float = 0.01,
+                   says: str | None = None) -> Requirement:
+    """The feed moves (or, with ``cutting=False``, any moves) pass through each point (machine X, Y, Z).
+
+    ``says`` words the requirement without its points (when they would answer another exercise); the
+    feedback then counts the points missed instead of naming them.
+    """
     kinds = (FEED, ARC_CW, ARC_CCW) if cutting else (RAPID, FEED, ARC_CW, ARC_CCW)
 
     def test(op, source):
@@ -187,10 +192,14 @@ def passes_through(points: Sequence[Sequence[float]], *, cutting: bool = True, t
         if rows.size:
             start, end, _ = _segments(op.waypoints, rows)
             missed = [p for p in points if _distance_to_segments(np.asarray(p, float), start, end) > tolerance]
-        return ("the cut never reaches " if cutting else "the tool never reaches ") \
-            + ", ".join(_xyz(p) for p in missed) if missed else None
+        if not missed:
+            return None
+        if says is not None:
+            return f"it misses {len(missed)} of the {len(points)} places"
+        return ("the cut never reaches " if cutting else "the tool never reaches ") + ", ".join(_xyz(p) for p in missed)
 
-    return Requirement(("cuts through " if cutting else "goes through ") + ", ".join(_xyz(p) for p in points), test)
+    text = ("cuts through " if cutting else "goes through ") + ", ".join(_xyz(p) for p in points)
+    return Requirement(says or text, test)
 
 
 def _distance_to_segments(point: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
@@ -327,8 +336,12 @@ def clears(box: Sequence[float], height: float) -> Requirement:
                        "or higher", test)
 
 
-def inside_box(box: Sequence[float], z_below: float, *, tolerance: float = 0.01) -> Requirement:
-    """Every tool-centre point below ``z_below`` stays inside the XY box ``(xmin, ymin, xmax, ymax)``."""
+def inside_box(box: Sequence[float], z_below: float, *, tolerance: float = 0.01,
+               says: str | None = None) -> Requirement:
+    """Every tool-centre point below ``z_below`` stays inside the XY box ``(xmin, ymin, xmax, ymax)``.
+
+    ``says`` words the requirement without the box's numbers.
+    """
 
     def test(op, source):
         path = path_points(op, (RAPID, FEED, ARC_CW, ARC_CCW))
@@ -344,7 +357,7 @@ def inside_box(box: Sequence[float], z_below: float, *, tolerance: float = 0.01)
         where = f" on line {_line(op, first[0])}" if first.size else ""
         return f"the tool centre leaves the box{where}"  # no coordinates: they could answer another exercise
 
-    return Requirement(f"below Z{z_below:g} the tool centre stays within X{box[0]:g}..{box[2]:g} "
+    return Requirement(says or f"below Z{z_below:g} the tool centre stays within X{box[0]:g}..{box[2]:g} "
                        f"Y{box[1]:g}..{box[3]:g}", test)
 
 
