@@ -34,12 +34,15 @@ EXPORT_FORMATS = ("csv", "parquet", "vtk", "events")
 _DEFAULT_SUFFIX = {"csv": None, "events": None, "parquet": ".parquet", "vtk": ".vtp"}
 
 
-class UsageError(ValueError):
+class UsageError(ConfigError):
     """A command-line argument that cannot work (exit status 2)."""
 
 
 def _parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     p = argparse.ArgumentParser(prog="gcodekit", description="Read, emulate and summarise G-code programs.")
+    p.add_argument("--version", action="version", version=f"gcodekit {__version__}")
     debug = argparse.ArgumentParser(add_help=False)
     debug.add_argument("--debug", action="store_true",
                        help="on an internal error, print the traceback (for a bug report)")
@@ -55,8 +58,8 @@ def _parser() -> argparse.ArgumentParser:
     export.add_argument("file", metavar="FILE")
     _common(export)
     export.add_argument("--to", choices=EXPORT_FORMATS, default="csv",
-                        help="csv or parquet: one row per motion; vtk: the deposition paths of an additive program "
-                             "(.vtp or .vtk); events: the Abaqus AM event series (default: csv)")
+                        help="csv or parquet: one row per motion; vtk: the deposition paths of an additive program, "
+                             "the toolpath of any other (.vtp or .vtk); events: the Abaqus AM event series (default: csv)")
     export.add_argument("--source", choices=("material", "heat"), default="material",
                         help="events: material deposition or the laser/weld heat source (default: material)")
     export.add_argument("-o", "--output", metavar="OUT",
@@ -115,6 +118,7 @@ def _parser() -> argparse.ArgumentParser:
     notebook.add_argument("--html", action="store_true",
                           help="also write NAME.html that shows its pictures offline (runs it)")
     notebook.add_argument("-f", "--force", action="store_true", help="overwrite NAME.ipynb if it exists")
+    _limits(notebook)
     return p
 
 
@@ -276,9 +280,12 @@ def _exists(path: str | None, args: argparse.Namespace) -> bool:
     return False
 
 
-def _report_errors(op) -> None:
+def _report_errors(op) -> int:
+    """Print the program's first errors; the exit status: 1 when a limit stopped it (the output is
+    partial), else 0."""
     for d in [d for d in op.diagnostics if d.severity == "error"][:10]:
         print(str(d), file=sys.stderr)
+    return EXIT_PROGRAM_ERROR if op.diagnostics.limit_errors else 0
 
 
 def _export(args: argparse.Namespace) -> int:
@@ -291,6 +298,7 @@ def _export(args: argparse.Namespace) -> int:
     if _exists(output, args):
         return 2
     op = _load(args.file, args)
+    status = _report_errors(op)  # first: a program a limit stopped may leave nothing to export
     target = output if output else sys.stdout
     if args.to == "csv":
         op.motions().to_csv(target, index=False, float_format="%.6f", lineterminator="\n")
@@ -308,15 +316,14 @@ def _export(args: argparse.Namespace) -> int:
         from .additive import AdditivePart
         from .export.vtk import VTKExporter
 
-        if op.machine.process != "additive":
-            raise UsageError(f"{args.file}: VTK export is for additive programs; machine {op.machine.name!r} "
-                             f"is {op.machine.process}")
-        part = AdditivePart(op)
-        if part.depositions.empty:
-            raise NothingToShowError(f"{args.file}: no deposition moves to export")
-        VTKExporter.additive_part_to_vtk(part, output)
-    _report_errors(op)
-    return 0
+        if op.process != "additive":
+            VTKExporter.toolpath_to_vtk(op, output)
+        else:
+            part = AdditivePart(op)
+            if part.depositions.empty:
+                raise NothingToShowError(f"{args.file}: no deposition moves to export")
+            VTKExporter.additive_part_to_vtk(part, output)
+    return status
 
 
 def _render(args: argparse.Namespace) -> int:
@@ -333,10 +340,10 @@ def _render(args: argparse.Namespace) -> int:
     if _exists(args.output, args):
         return 2
     op = _load(args.file, args)
+    status = _report_errors(op)  # first: a program a limit stopped may leave nothing to draw
     plot_operation(op, args.color_by, show_travel=args.travel, tool_vectors=args.tool_vectors, camera=args.view,
                    screenshot=args.output, window_size=size)
-    _report_errors(op)
-    return 0
+    return status
 
 
 def _translate(args: argparse.Namespace) -> int:
@@ -355,8 +362,7 @@ def _translate(args: argparse.Namespace) -> int:
         Path(args.output).write_text(text)
     else:
         sys.stdout.write(text)
-    _report_errors(op)
-    return 0
+    return _report_errors(op)
 
 
 def _report(args: argparse.Namespace) -> int:
@@ -405,7 +411,8 @@ def _notebook(args: argparse.Namespace) -> int:
 
         load_machine(args.machine)
     write_exploration_notebook(args.file, args.output, machine=args.machine, machine_config=args.machine_config,
-                               execute=args.execute, html=args.html)
+                               execute=args.execute, html=args.html, max_motions=args.max_motions,
+                               max_iterations=args.max_iterations)
     print(f"notebook written to {args.output}" + (" (and its .html)" if args.html else ""))
     return 0
 

@@ -1,4 +1,4 @@
-"""The exploration notebook in notebooks/: executed headless with nbclient, exported to HTML and
+"""The notebooks in notebooks/ (exploration, FreeCAD Path): executed headless with nbclient, exported to HTML and
 opened offline in Chromium.  Also ``gcodekit notebook`` (from a built wheel: tests/test_packaging.py).
 The worksheets are tested in tests/test_worksheets.py.
 """
@@ -18,7 +18,7 @@ from gcodekit.widgets.export import WIDGET_VIEW, execute, offline_html  # noqa: 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
 
-ALL = ["explore.ipynb"]  # the worksheets: tests/test_worksheets.py
+ALL = ["explore.ipynb", "freecad_path.ipynb"]  # the worksheets: tests/test_worksheets.py
 
 
 def _outputs(nb):

@@ -127,3 +127,17 @@ def test_plain_nbconvert_shows_widget_pictures_where_the_wheel_is_installed(inst
     page = (tmp_path / "handin.html").read_text()
     assert page.count('src="data:image/png;base64,') == 1
     assert "widget-view+json" not in page and not re.search(r"<script[^>]*\ssrc=\"https?:", page)
+
+
+def test_freecad_path_api_runs_from_the_wheel(installed, tmp_path):
+    """gcodekit.path (a front end) ships: a job post-processed and pre-processed from the installed wheel."""
+    python, _, _ = installed
+    script = ("import gcodekit.path as Path\n"
+              "job = Path.Job(tooltable=Path.Tooltable([Path.Tool('e', tooltype='EndMill', diameter=3)]))\n"
+              "job.add(Path.Path('G0 Z5 G1 X10 F100 G2 X10 Y0 I-5 J0'), tool=1)\n"
+              "text = Path.post_process(job, 'fanuc')\n"
+              "print(Path.__file__); print(round(Path.read(text, machine='fanuc').Length, 4))\n")
+    out = subprocess.run([str(python), "-I", "-c", script], check=True, capture_output=True, text=True,
+                         cwd=tmp_path).stdout.split()
+    assert not out[0].startswith(str(ROOT / "gcodekit"))
+    assert float(out[1]) == pytest.approx(5 + 10 + 10 * 3.141592653589793, abs=1e-3)  # up, along, a whole circle

@@ -16,6 +16,8 @@ Examples
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from ..errors import Diagnostics
@@ -23,13 +25,16 @@ from ..read import Blocks
 from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
-from .profiles import lathe_profiles
+from .lathe_profiles import lathe_profiles
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
 from .word_checks import MODAL_USERS, WORD_USERS, stray_letters, stray_word_message, user_code_keys
 from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CCW, MOTION_CUBIC, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
                     MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable)
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
+#: LinuxCNC's log comments: (LOGOPEN,file), (LOGAPPEND,file), (LOG,text), (LOGCLOSE)
+_LOG_COMMENT = re.compile(rb"(?i)\s*(?:log(?:open|append)?\s*,|logclose\s*$)")
+_LOG_HINT = re.compile(rb"(?i)log")
 _KEEP = 255  # "this row does not set the motion mode"
 #: Parameter letters and their row in the per-chunk parameter table.
 PARAM_LETTERS = "ABCDEFGHIJKLMNOPQRSTUVWXYZ@^"
@@ -68,11 +73,27 @@ class GcodeParser:
         self._unknown_reported: set[str] = set()
         self._cycle_ids = np.array([NAME_ID[n] for n in CYCLE_NAMES], np.uint8)
         self._lathe_ids = np.array([NAME_ID[n] for n in LATHE_CYCLE_NAMES], np.uint8)
+        self._log_comments = self.flavor.state_parameters == "linuxcnc"  # said once per program
+
+    def _note_log_comment(self, blocks: Blocks) -> None:
+        """Warn, once, at LinuxCNC's first ``(LOGOPEN,...)``, ``(LOGAPPEND,...)``, ``(LOG,...)`` or
+        ``(LOGCLOSE)`` comment: the interpreter writes such comments to a log file; gcodekit writes none."""
+        offsets, data = blocks.comment_offsets, blocks.comment_data
+        for k in range(len(offsets) - 1):
+            if _LOG_COMMENT.match(data[offsets[k]:offsets[k + 1]]):
+                line = int(blocks.block_line[blocks.comment_block[k]])
+                self.diagnostics.warn(line, int(blocks.comment_col[k]), "LinuxCNC writes (LOG,...) comments to the "
+                                      "file (LOGOPEN,...) opens; gcodekit runs them as plain comments and writes no "
+                                      "log file")
+                self._log_comments = False
+                return
 
     # -- public ---------------------------------------------------------------
 
     def parse(self, blocks: Blocks) -> CommandTable:
         """Commands of ``blocks``, continuing the modal state of earlier calls."""
+        if self._log_comments and _LOG_HINT.search(blocks.comment_data):
+            self._note_log_comment(blocks)
         n_blocks = len(blocks)
         wb, wl = blocks.word_block, blocks.word_letter
         is_code = (wl == _G) | (wl == _M)

@@ -33,7 +33,7 @@ from ..plan import machine_options as firmware_options
 from ..plan import planner_settings, run_planner
 from ..read import Blocks
 from ..syntax import Flavor
-from .assemble import concat_waypoints, empty_table, new_machine, raise_first_run
+from .assemble import concat_waypoints, empty_table, new_machine, raise_first_run, warn_implausible_time
 from .program import Program, as_program, check_program_end, note_weak_detection, progress_bar, quote_diagnostics, resolve
 from .source import program_blocks, restore_line_numbers
 
@@ -133,7 +133,9 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         diagnostics.extend(op.diagnostics)  # its warnings
         op.diagnostics = diagnostics
     if plan and config.planner:
-        run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
+        op.attach_plan(run_planner(op, config.planner,
+                                   planner_settings(config.planner, config.planner_settings, machine_config)))
+    warn_implausible_time(op)
     restore_line_numbers(op.table, diagnostics)
     quote_diagnostics(op.diagnostics, program)
     return op
