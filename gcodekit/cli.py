@@ -252,6 +252,8 @@ def _text(r: dict[str, Any]) -> str:
     if r["layers"] is not None:
         filament = f"   filament {r['filament_mm']:.1f} mm" if r["filament_mm"] is not None else ""
         lines.append(f"  layers     {r['layers']}{filament}")
+    if r.get("slicer"):
+        lines.append(_slicer_line(r))
     if r["tools"]:
         lines.append(f"  tools      {' '.join(map(str, r['tools']))}")
     diags = r["diagnostics"]
@@ -263,6 +265,19 @@ def _text(r: dict[str, Any]) -> str:
     if len(diags) > 20:
         lines.append(f"    ... {len(diags) - 20} more (see --json)")
     return "\n".join(lines) + "\n"
+
+
+def _slicer_line(r: dict[str, Any]) -> str:
+    """What the slicer says beside gcodekit's figures, with the difference."""
+    from .model.slicer import compare
+
+    theirs = r["slicer"]
+    name = " ".join(v for v in (theirs["slicer"], theirs["version"]) if v) or "slicer"
+    shown = {"time": lambda v: _duration(v), "filament": lambda v: f"{v:.1f} mm", "layers": str}
+    parts = [f"{row['figure']} {shown[row['figure']](row['slicer'])}"
+             + (f" (gcodekit {100 * row['difference']:+.1f} %)" if row["difference"] else " (gcodekit the same)")
+             for row in compare(r)]
+    return f"  slicer     {name} says: " + ("  ".join(parts) or "no figures")
 
 
 def _duration(seconds: float) -> str:

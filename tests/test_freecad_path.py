@@ -360,7 +360,7 @@ def test_the_preprocessor_never_crashes_on_the_corpus():
         for d in path.diagnostics:
             assert d.line >= 0 and d.column >= 0 and d.message
         with_diagnostics += len(path.diagnostics) > 0
-    assert with_diagnostics == 92
+    assert with_diagnostics == 93  # 92, and smartprobe.ngc: its (LOGOPEN,...) writes no log file here (a true warning)
 
 
 # -- properties -----------------------------------------------------------------------------------

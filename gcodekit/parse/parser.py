@@ -413,7 +413,11 @@ class GcodeParser:
                 continue
             self._unknown_reported.add(code)
             line = int(t["line"][i])
-            if self.flavor.other_codes and code not in self.flavor.other_codes:
+            what = self.flavor.firmware_codes.get(code)
+            if what is not None:
+                self.diagnostics.report(line, 1, f"{code} ({what}) is a {self.flavor.name} code gcodekit does not "
+                                        "model; kept as a generic command", severity="info")
+            elif self.flavor.other_codes and code not in self.flavor.other_codes:
                 # the dialect's list is complete: LinuxCNC stops here (convert_g / convert_m)
                 self.diagnostics.report(line, 1, f"Unknown {code[0].lower()} code used: {code} "
                                         f"is not a {self.flavor.name} code", kind="machine")
