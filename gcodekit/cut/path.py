@@ -1,6 +1,7 @@
 """Outputs: a mill operation's moves as straight pieces of the tool tip's path, arcs cut into chords.
 
-The waypoints are the spindle's controlled point in machine coordinates
+The first move is left out (it starts wherever the machine was).  The
+waypoints are the spindle's controlled point in machine coordinates
 with the program's tool length offsets applied (G43 adds the offset, G49
 removes it).  The tool's tip is its table length below that point, so a
 program that sets its offsets as the tool table says cuts where it means
@@ -22,10 +23,14 @@ RAPID, FEED, ARC_CW, ARC_CCW = 1, 2, 3, 4
 
 
 def moving_rows(w: dict) -> np.ndarray:
-    """Waypoints that move (each from the waypoint before it)."""
-    motion = np.asarray(w["motion"])
-    rows = np.flatnonzero(motion > 0)
-    return rows[rows > 0]
+    """Waypoints that move (each from the waypoint before it), less the first move.
+
+    The first move starts where the machine happened to be before the
+    program, which the program does not say (the emulator's start is the
+    machine's zero, often inside the stock's box): it is not cut.
+    """
+    rows = np.flatnonzero(np.asarray(w["motion"]) > 0)
+    return rows[1:] if rows.size else rows
 
 
 def chord_angle(w: dict, rows: np.ndarray, tolerance: float) -> float:

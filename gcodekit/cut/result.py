@@ -82,7 +82,7 @@ class CutResult:
                                          f"{rapid_cuts.size - 100} more rapid moves cut the stock"))
         self._rapid_rows = rapid_cuts
         if self.cut_through >= 0 and self.removed_mm3 <= threshold and not any(
-                "never reaches" in d.message for d in self.notes):
+                word in d.message for d in self.notes for word in ("never reaches", "no feed moves")):
             self.notes.append(Diagnostic(self.op.file, 0, 0, "warning", "the program removes no material from "
                                          "the stock (its tools never go below the stock's top where it is)"))
 
@@ -202,7 +202,7 @@ def part_mesh(stock: Stock, top: np.ndarray, max_cells: int | None = None) -> "p
     corners = solid[:-1, :-1] & solid[1:, :-1] & solid[:-1, 1:] & solid[1:, 1:]
     if ny < 2 or nx < 2 or not corners.any():
         return pv.PolyData()
-    part = grid.extract_cells(np.flatnonzero(corners.ravel())).extract_surface()
+    part = grid.extract_cells(np.flatnonzero(corners.ravel())).extract_surface(algorithm="dataset_surface")
     return part.triangulate().clean()
 
 

@@ -62,8 +62,9 @@ class CutSimulation:
         An emulated operation (mm; see :mod:`gcodekit.cut.path` for the tool tip).
     stock : Stock, default: None
         The material; None makes a box: the bounding box of the feed moves'
-        tool envelopes, its top at the highest point a feed move reaches and
-        its bottom 1 mm below the deepest.
+        tool envelopes, its top at the highest point where a feed move ends
+        (a plunge's start is the rapid's end, above the work) and its
+        bottom 1 mm below the deepest point.
     tools : ToolLibrary, default: None
         The shape of each tool number.  A tool the program uses that has no
         shape is cut as a 6 mm flat end mill, with a warning naming it.
@@ -170,18 +171,17 @@ class CutSimulation:
         motion = np.asarray(w["motion"])[pieces.owner]
         cutting = (motion == FEED) | (motion == ARC_CW) | (motion == ARC_CCW)
         if not cutting.any():
-            raise ConfigError(f"{self.op.file}: no feed moves, so no stock can be made from the program; "
-                              "give the stock (--stock X0,Y0,Z0,X1,Y1,Z1)")
+            self.notes.append(Diagnostic(self.op.file, 0, 0, "warning", "the program has no feed moves (G1, G2, "
+                                         "G3): nothing to cut, and no stock to make from it (give --stock)"))
+            return Stock(0.0, 0.0, resolution, np.zeros((1, 1)), np.zeros((1, 1)))
         p = pieces.take(np.flatnonzero(cutting))
         radius = np.array([self.shapes[int(t)].radius for t in p.tool])
         both = np.concatenate([p.p0, p.p1])
         r2 = np.concatenate([radius, radius])
         x0, x1 = float((both[:, 0] - r2).min()), float((both[:, 0] + r2).max())
         y0, y1 = float((both[:, 1] - r2).min()), float((both[:, 1] + r2).max())
-        z0, z1 = float(both[:, 2].min()) - FLOOR_MARGIN, float(both[:, 2].max())
-        if z1 <= z0 + FLOOR_MARGIN:
-            raise ConfigError(f"{self.op.file}: the feed moves never go down (all at Z {z1:g}), so no stock can be "
-                              "made from the program; give the stock (--stock X0,Y0,Z0,X1,Y1,Z1)")
+        # the top: the highest point a feed move ends at (a plunge's start is the rapid's end, above the work)
+        z0, z1 = float(both[:, 2].min()) - FLOOR_MARGIN, float(p.p1[:, 2].max())
         if not explicit and (x1 - x0) * (y1 - y0) / resolution**2 > DEFAULT_MAX_CELLS:
             coarser = math.sqrt((x1 - x0) * (y1 - y0) / DEFAULT_MAX_CELLS)
             self.notes.append(Diagnostic(self.op.file, 0, 0, "info",

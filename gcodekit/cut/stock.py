@@ -174,7 +174,7 @@ class Stock:
                 mesh = pv.read(mesh)
             except (ValueError, OSError, RuntimeError) as exc:
                 raise ConfigError(f"{mesh}: cannot be read as a mesh: {exc}") from None
-        surface = mesh.extract_surface().triangulate()
+        surface = mesh.extract_surface(algorithm="dataset_surface").triangulate()
         if surface.n_cells == 0:
             raise ConfigError("the stock mesh has no faces")
         tri = surface.points[surface.faces.reshape(-1, 4)[:, 1:]].astype(float)  # (n, 3 corners, xyz)
