@@ -74,7 +74,7 @@ def _operation(program):
     return gcodekit.gcode_to_operation(program, machine="linuxcnc")
 
 
-def _manifold_removed(op, tool: ToolShape) -> float:
+def _manifold_removed(op, tool: ToolShape, stock=STOCK) -> float:
     """Exact removed volume: the union of every move's swept hull, intersected with the stock box."""
     m = manifold3d
     profile = tool.profile(24)
@@ -85,7 +85,7 @@ def _manifold_removed(op, tool: ToolShape) -> float:
     pieces = tool_tip_pieces(op.waypoints, {}, tolerance=0.001)
     hulls = [m.Manifold.hull_points(np.vstack([body + a, body + b])) for a, b in zip(pieces.p0, pieces.p1)]
     swept = m.Manifold.batch_boolean(hulls, m.OpType.Add)
-    x0, y0, z0, x1, y1, z1 = STOCK
+    x0, y0, z0, x1, y1, z1 = stock
     box = m.Manifold.cube((x1 - x0, y1 - y0, z1 - z0)).translate((x0, y0, z0))
     return (swept ^ box).volume()
 

@@ -180,8 +180,10 @@ class CutSimulation:
         r2 = np.concatenate([radius, radius])
         x0, x1 = float((both[:, 0] - r2).min()), float((both[:, 0] + r2).max())
         y0, y1 = float((both[:, 1] - r2).min()), float((both[:, 1] + r2).max())
-        # the top: the highest point a feed move ends at (a plunge's start is the rapid's end, above the work)
-        z0, z1 = float(both[:, 2].min()) - FLOOR_MARGIN, float(p.p1[:, 2].max())
+        # the top: the highest point a feed move ends at (a plunge's start is the rapid's end, above the work;
+        # so is a helix's, and its chords' ends do not count either)
+        ends = np.r_[p.owner[1:] != p.owner[:-1], True]
+        z0, z1 = float(both[:, 2].min()) - FLOOR_MARGIN, float(p.p1[ends, 2].max())
         if not explicit and (x1 - x0) * (y1 - y0) / resolution**2 > DEFAULT_MAX_CELLS:
             coarser = math.sqrt((x1 - x0) * (y1 - y0) / DEFAULT_MAX_CELLS)
             self.notes.append(Diagnostic(self.op.file, 0, 0, "info",
