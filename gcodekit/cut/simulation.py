@@ -71,7 +71,7 @@ class CutSimulation:
     resolution : float, default: None
         Grid cell size, mm, for a stock made from the program; None: 0.1 mm,
         or a twentieth of the smallest tool's diameter if that is finer,
-        coarser when the grid would pass 16 million cells.
+        coarser when the grid would pass ``max_cells``.
     tolerance : float, default: None
         Largest distance of arc chords from the arc, mm (default: a tenth of
         the resolution).
@@ -81,6 +81,9 @@ class CutSimulation:
         Keep the height field every block of moves (within 256 MB), so that
         :meth:`cut_to` can go back without cutting from the start (the live
         view does; a single run does not need it).
+    max_cells : int, default: 16 million
+        The most cells the default resolution gives a stock made from the
+        program (a coarser grid beyond, with a note).
 
     Raises
     ------
@@ -91,7 +94,8 @@ class CutSimulation:
 
     def __init__(self, op, *, stock: Stock | None = None, tools: ToolLibrary | None = None,
                  resolution: float | None = None, tolerance: float | None = None, engine: str = "auto",
-                 keep_states: bool = False):
+                 keep_states: bool = False, max_cells: int = DEFAULT_MAX_CELLS):
+        self.max_cells = max_cells
         self.engine = check_choice("engine", engine, ENGINES)
         if getattr(op, "waypoints", None) is None:
             raise ConfigError(f"{op.file}: cutting needs an emulated operation (use gcode_to_operation)")
@@ -184,11 +188,11 @@ class CutSimulation:
         # so is a helix's, and its chords' ends do not count either)
         ends = np.r_[p.owner[1:] != p.owner[:-1], True]
         z0, z1 = float(both[:, 2].min()) - FLOOR_MARGIN, float(p.p1[ends, 2].max())
-        if not explicit and (x1 - x0) * (y1 - y0) / resolution**2 > DEFAULT_MAX_CELLS:
-            coarser = math.sqrt((x1 - x0) * (y1 - y0) / DEFAULT_MAX_CELLS)
+        if not explicit and (x1 - x0) * (y1 - y0) / resolution**2 > self.max_cells:
+            coarser = math.sqrt((x1 - x0) * (y1 - y0) / self.max_cells)
             self.notes.append(Diagnostic(self.op.file, 0, 0, "info",
                                          f"a {resolution:g} mm grid over {x1 - x0:g} x {y1 - y0:g} mm would pass "
-                                         f"{DEFAULT_MAX_CELLS:,} cells: cut at {coarser:.3g} mm"))
+                                         f"{self.max_cells:,} cells: cut at {coarser:.3g} mm"))
             resolution = coarser
             self.tolerance = max(self.tolerance, resolution / 10)
         check_grid(x1 - x0, y1 - y0, resolution)

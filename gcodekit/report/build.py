@@ -31,7 +31,7 @@ MAX_DIAGNOSTICS = 200
 MAX_TOOLPATH_LINES = 5000
 
 
-def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
+def report_data(op: "Operation", *, transpile: bool = True, cut: bool = True) -> dict[str, Any]:
     """Summary, breakdown and (mill programs) transpiler stages of an emulated operation.
 
     Parameters
@@ -40,11 +40,13 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
         An emulated operation (from :func:`gcodekit.gcode_to_operation`).
     transpile : bool, default: True
         Add the transpiler's stage table and final toolpath for subtractive programs.
+    cut : bool, default: True
+        Add the material removal of mill programs (:mod:`gcodekit.report.cut`).
 
     Returns
     -------
     dict with ``name``, ``summary``, ``breakdown`` (``by``, ``rows``), ``layers``
-    (per-layer rows, additive only), ``stages`` and ``toolpath`` (mill only).
+    (per-layer rows, additive only), ``stages``, ``toolpath`` and ``cut`` (mill only).
     """
     summary = op.summary()
     additive = summary["process"] == "additive"
@@ -52,7 +54,8 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
     summary["diagnostics"] = [{**d, "elsewhere": Path(d["file"]).name if d["file"] != op.diagnostics.file else ""}
                               for d in summary["diagnostics"][:MAX_DIAGNOSTICS]]
     data: dict[str, Any] = {"name": Path(op.file).name, "summary": summary,
-                            "breakdown": breakdown(op), "layers": None, "stages": None, "toolpath": None}
+                            "breakdown": breakdown(op), "layers": None, "stages": None, "toolpath": None,
+                            "cut": None}
     if additive:
         by_layer = op.time_by("layer")
         by_layer = by_layer[by_layer.index >= 0]
@@ -66,6 +69,10 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
         lines = t.stage(6).splitlines()
         data["toolpath"] = {"text": "\n".join(lines[:MAX_TOOLPATH_LINES]), "lines": len(lines),
                             "shown": min(len(lines), MAX_TOOLPATH_LINES)}
+    if cut and summary["process"] == "subtractive" and "lathe" not in op.machine.name:
+        from .cut import cut_section
+
+        data["cut"] = cut_section(op)
     return data
 
 
