@@ -40,24 +40,15 @@ _CATEGORY_COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c5
 _MAX_GLYPHS = 300
 
 
-def _is_additive(op: "Operation") -> bool:
-    return op.machine is not None and op.machine.process == "additive"
-
-
 def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
     """Waypoints that are the work and the rest of the moves.
 
     The work is the depositing moves from the first layer on (start-code purge
     lines are not the part) or, for a mill, the feed moves.
     """
-    w = op.waypoints
-    moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
+    moving = op.moving.copy()
     moving[:1] = False  # a move is drawn from the waypoint before it
-    if _is_additive(op):
-        work = op.depositing & (op.layers >= 0)
-    else:
-        work = np.asarray(w["motion"]) >= 2
-    work &= moving
+    work = op.work & moving
     return work, moving & ~work
 
 
@@ -147,7 +138,7 @@ def default_scalars(op: "Operation") -> str:
     """``feature`` when the program names its features, else ``layer`` (additive) or ``feed``."""
     if op.flavor is not None and op.flavor.feature_comment and (op.features != "").any():
         return "feature"
-    return "layer" if _is_additive(op) else "feed"
+    return "layer" if op.process == "additive" else "feed"
 
 
 def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: bool = False,
@@ -189,7 +180,7 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
     scalars = scalars or default_scalars(op)
     mesh, travel, categories = operation_polydata(op, scalars)
     if mesh.n_cells == 0 and (travel.n_cells == 0 or not show_travel):
-        raise NothingToShowError(f"{op.file}: nothing to draw (no {'deposition' if _is_additive(op) else 'feed'} "
+        raise NothingToShowError(f"{op.file}: nothing to draw (no {'deposition' if op.process == 'additive' else 'feed'} "
                                  "moves)")
     plotter = pv.Plotter(off_screen=off_screen, window_size=list(window_size))
     plotter.set_background(background)

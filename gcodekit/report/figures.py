@@ -64,11 +64,10 @@ def toolpath_segments(op: "Operation") -> Segments:
     commanded speed, with rapids flagged.
     """
     w = op.waypoints
-    additive = op.machine is not None and op.machine.process == "additive"
+    additive = op.process == "additive"
     xyz = np.column_stack([w["x"], w["y"], w["z"]]).astype(float)
     prev = np.vstack([xyz[:1], xyz[:-1]])
-    moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
-    keep = op.depositing if additive else moving
+    keep = op.depositing if additive else op.moving
     idx = np.flatnonzero(keep)
     labels = None
     if additive:

@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import GcodeError
+
 if TYPE_CHECKING:
     from ..model.operation import Operation
 
@@ -35,7 +37,7 @@ GROUP_BY = ("layer", "z", "line")
 WORK, TRAVEL = 0, 1
 
 
-class ToolpathError(ValueError):
+class ToolpathError(GcodeError, ValueError):
     """A program the viewers cannot draw (no file, no motions, nothing readable)."""
 
 
@@ -93,7 +95,7 @@ class Toolpath:
             When the source cannot be read or has no motion to draw.
         """
         from ..errors import check_choice
-        from ..visualize import _is_additive, move_masks
+        from ..visualize import move_masks
 
         op, waypoint_layer = _operation(source, waypoint_layer)
         w = op.waypoints
@@ -103,7 +105,7 @@ class Toolpath:
         moving = work | travel
         if not moving.any():
             raise ToolpathError(f"{op.file}: the program has no motions to draw")
-        additive = _is_additive(op)
+        additive = op.process == "additive"
         group_by = group_by or ("layer" if additive else "z")
         check_choice("group_by", group_by, GROUP_BY)
         rows = np.flatnonzero(moving)
@@ -191,7 +193,7 @@ def _operation(source, waypoint_layer):
 
 def _command_rows(op: "Operation") -> np.ndarray:
     w = op.waypoints
-    return w["command"] if "command" in w else np.arange(len(op.table))
+    return w["command"]
 
 
 def _group_keys(op, rows, work, group_by, waypoint_layer) -> tuple[np.ndarray, list[str]]:
