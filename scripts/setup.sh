@@ -2,7 +2,7 @@
 # Create .venv and install gcodekit with its test and report tools, once per
 # change of pyproject.toml; install Chromium (PDF reports) and poppler-utils
 # (the PDF test) with apt-get when missing, and for the tests LinuxCNC's rs274
-# (the differential check against it).  Sourced by run-examples.sh and
+# (the differential check against it) and Cura's printer definitions.  Sourced by run-examples.sh and
 # run-tests.sh (which sets GCODEKIT_SETUP_RS274=1).
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -56,6 +56,16 @@ if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -x /usr/bin/rs274 ]; then
   fi
 fi
 
+# Cura's printer definitions (Debian package cura) are the reference the Creality Ender-3 preset is
+# checked against (tests/test_slicer_figures.py); only the test command asks for them.
+if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -f /usr/share/cura/resources/definitions/creality_base.def.json ]; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    apt_install "Cura's printer definitions, the reference of the Ender-3 preset" --no-install-recommends cura
+  else
+    die "the slicer tests need Cura's printer definitions: install them as root (apt-get install --no-install-recommends cura), then run this again"
+  fi
+fi
+
 want=$(cat "$ROOT/pyproject.toml" | sha256sum | cut -d' ' -f1)
 if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$want" ]; then
   echo "gcodekit setup: installing gcodekit and its test tools into .venv" >&2
@@ -63,3 +73,9 @@ if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$want" ]; then
   "$VENV/bin/python" -m pip install -q -e "$ROOT[test]" || die "pip could not install gcodekit (is the package index reachable?)"
   echo "$want" > "$STAMP"
 fi
+
+# An editable install leaves out data files: put gcodekit's Jupyter settings where its wheel puts them, so
+# plain `jupyter nbconvert --to html` and JupyterLab's HTML export show the widgets' pictures offline here too.
+mkdir -p "$VENV/etc/jupyter/jupyter_server_config.d"
+cp "$ROOT/jupyter-config/jupyter_nbconvert_config.json" "$VENV/etc/jupyter/"
+cp "$ROOT/jupyter-config/jupyter_server_config.d/gcodekit.json" "$VENV/etc/jupyter/jupyter_server_config.d/"
