@@ -1,4 +1,4 @@
-"""Command line: ``gcodekit info``, ``export``, ``render``, ``translate``, ``report`` and ``notebook``.
+"""Command line: ``gcodekit info``, ``export``, ``render``, ``translate``, ``report``, ``notebook`` and ``cut``.
 
 Examples
 --------
@@ -11,6 +11,7 @@ Examples
     gcodekit render print.gcode -o print.png --color-by speed --view top
     gcodekit report *.gcode -o reports/ --workers 2
     gcodekit notebook part.gcode -o part.ipynb
+    gcodekit cut part.ngc --tools TOOLS.toml --stock 0,0,-10,60,40,0 -o part.stl
 """
 
 from __future__ import annotations
@@ -119,7 +120,26 @@ def _parser() -> argparse.ArgumentParser:
                           help="also write NAME.html that shows its pictures offline (runs it)")
     notebook.add_argument("-f", "--force", action="store_true", help="overwrite NAME.ipynb if it exists")
     _limits(notebook)
+    _cut_parser(add("cut", help="cut the stock with a mill program's tools: volumes, air cuts, the part"))
     return p
+
+
+def _cut_parser(cut: argparse.ArgumentParser) -> None:
+    cut.add_argument("file", metavar="PROGRAM")
+    _common(cut)
+    cut.add_argument("--stock", metavar="X0,Y0,Z0,X1,Y1,Z1",
+                     help="stock box corners, mm (default: the box round the feed moves' tool envelopes)")
+    cut.add_argument("--stock-file", metavar="STOCK.stl", help="stock as a closed mesh (STL, PLY, VTP)")
+    cut.add_argument("--tools", metavar="TOOLS.toml", help="tool shapes, one [T<n>] table per tool")
+    cut.add_argument("--tool-table", metavar="T.tbl",
+                     help="LinuxCNC tool table: the machine's tool lengths, and flat end mills of its diameters")
+    cut.add_argument("--tool-table-units", choices=("mm", "inch"), default="mm",
+                     help="units of the tool table's numbers (default: mm)")
+    cut.add_argument("--resolution", type=float, metavar="MM",
+                     help="grid cell size, mm (default: 0.1, finer for tools under 2 mm)")
+    cut.add_argument("--json", action="store_true", help="print the volumes and findings as JSON")
+    cut.add_argument("-o", "--output", metavar="PART.vtp|PART.stl", help="write the cut part's mesh")
+    cut.add_argument("-f", "--force", action="store_true", help="overwrite the part file if it exists")
 
 
 def _positive(text: str) -> int:
@@ -433,8 +453,69 @@ def _notebook(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cut(args: argparse.Namespace) -> int:
+    from .cut import CutSimulation, Stock, ToolLibrary
+
+    if args.output and Path(args.output).suffix.lower() not in (".vtp", ".stl", ".vtk", ".ply"):
+        raise UsageError(f"{args.output}: the part is written to a .vtp, .stl, .vtk or .ply file")
+    if args.stock and args.stock_file:
+        raise UsageError("give --stock or --stock-file, not both")
+    if _exists(args.output, args):
+        return 2
+    for path in (args.tools, args.tool_table, args.stock_file):
+        if path and not os.path.isfile(path):
+            raise FileNotFoundError(f"no such file: {path}")
+    resolution = args.resolution
+    if resolution is not None and not (math.isfinite(resolution) and resolution > 0):
+        raise UsageError(f"--resolution {resolution:g}: give a positive cell size in mm")
+    tools = ToolLibrary.read(args.tools) if args.tools else ToolLibrary()
+    options = {}
+    if args.tool_table:
+        from .emulate.tooltable import ToolTable
+
+        options = {"tool_table": args.tool_table, "tool_table_units": args.tool_table_units}
+        tools = tools.merged(ToolLibrary.from_tool_table(ToolTable.read(args.tool_table,
+                                                                        units=args.tool_table_units)))
+    stock = None
+    if args.stock:
+        try:
+            corners = [float(v) for v in args.stock.split(",")]
+        except ValueError:
+            corners = []
+        if len(corners) != 6:
+            raise UsageError(f"--stock {args.stock!r}: give six numbers X0,Y0,Z0,X1,Y1,Z1 in mm")
+        stock = Stock.box(*corners, resolution=resolution or 0.1)
+    elif args.stock_file:
+        stock = Stock.from_mesh(args.stock_file, resolution=resolution or 0.1)
+    if not os.path.isfile(args.file):
+        raise FileNotFoundError(f"no such file: {args.file}")
+    from .pipeline import gcode_to_operation
+
+    op = gcode_to_operation(Path(args.file), args.machine, flavor=args.flavor, machine_config=args.machine_config,
+                            mode="strict" if args.strict else "lenient", max_motions=args.max_motions,
+                            max_iterations=args.max_iterations, **options)
+    result = CutSimulation(op, stock=stock, tools=tools, resolution=resolution).run()
+    if args.output:
+        result.save(args.output)
+    summary = result.summary()
+    if args.json:
+        print(json.dumps(_json_safe(summary), indent=1))
+    else:
+        x0, y0, z0, x1, y1, z1 = summary["stock"]
+        print(f"{op.file}: stock {x0:g},{y0:g},{z0:g} to {x1:g},{y1:g},{z1:g} mm at {summary['resolution_mm']:g} mm\n"
+              f"  stock {summary['stock_mm3']:,.1f} mm^3, removed {summary['removed_mm3']:,.1f} mm^3, "
+              f"remaining {summary['remaining_mm3']:,.1f} mm^3\n"
+              f"  air cuts: {summary['air_cuts']} moves, {_duration(summary['air_cut_s'])}; "
+              f"rapids into stock: {len(summary['rapid_collisions'])}"
+              + (f"\n  part written to {args.output}" if args.output else ""))
+    for note in result.notes:
+        print(str(note), file=sys.stderr)
+    _report_errors(op)
+    return 0
+
+
 _COMMANDS = {"info": _info, "export": _export, "render": _render, "translate": _translate, "report": _report,
-             "notebook": _notebook}
+             "notebook": _notebook, "cut": _cut}
 
 if __name__ == "__main__":
     sys.exit(main())

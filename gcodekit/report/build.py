@@ -33,7 +33,7 @@ MAX_DIAGNOSTICS = 200
 MAX_TOOLPATH_LINES = 5000
 
 
-def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
+def report_data(op: "Operation", *, transpile: bool = True, cut: bool = True) -> dict[str, Any]:
     """Summary, breakdown and (mill programs) transpiler stages of an emulated operation.
 
     Parameters
@@ -42,6 +42,8 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
         An emulated operation (from :func:`gcodekit.gcode_to_operation`).
     transpile : bool, default: True
         Add the transpiler's stage table and final toolpath for subtractive programs.
+    cut : bool, default: True
+        Add the material removal of mill programs (:mod:`gcodekit.report.cut`).
 
     Returns
     -------
@@ -49,8 +51,8 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
     (per-layer rows, additive only), ``slicer_rows`` (gcodekit's figures
     beside the slicer's, :func:`gcodekit.model.slicer.compare`),
     ``slicer_layers`` (the layers the slicer's progress marks close,
-    :func:`gcodekit.analysis.slicer_layer_times`), ``stages`` and ``toolpath``
-    (mill only).
+    :func:`gcodekit.analysis.slicer_layer_times`), ``stages``, ``toolpath`` and
+    ``cut`` (mill only).
     """
     summary = op.summary()
     additive = summary["process"] == "additive"
@@ -59,7 +61,8 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
                               for d in summary["diagnostics"][:MAX_DIAGNOSTICS]]
     data: dict[str, Any] = {"name": Path(op.file).name, "summary": summary,
                             "breakdown": breakdown(op), "layers": None, "stages": None, "toolpath": None,
-                            "slicer_rows": compare(summary), "slicer_layers": []}
+                            "slicer_rows": compare(summary), "slicer_layers": [],
+                            "cut": None}
     if additive:
         by_layer = op.time_by("layer")
         by_layer = by_layer[by_layer.index >= 0]
@@ -77,6 +80,10 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
         lines = t.stage(6).splitlines()
         data["toolpath"] = {"text": "\n".join(lines[:MAX_TOOLPATH_LINES]), "lines": len(lines),
                             "shown": min(len(lines), MAX_TOOLPATH_LINES)}
+    if cut and summary["process"] == "subtractive" and "lathe" not in op.machine.name:
+        from .cut import cut_section
+
+        data["cut"] = cut_section(op)
     return data
 
 

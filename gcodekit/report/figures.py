@@ -30,7 +30,7 @@ MAX_2D_SEGMENTS = 60_000
 ARC_CHORDS = 16
 THUMBNAILS = 12
 #: The pictures of a report page.
-FIGURES = ("iso", "top", "layer_times", "thumbnails", "velocity", "breakdown")
+FIGURES = ("iso", "top", "layer_times", "thumbnails", "velocity", "breakdown", "part")
 DPI = 100
 WIDTH_IN = 8.0
 
@@ -382,4 +382,16 @@ def report_figures(op: "Operation", data: dict[str, Any]) -> dict[str, str]:
         figures["thumbnails"] = layer_thumbnails(seg) if seg.start.shape[0] else None
     figures["velocity"] = velocity(op)
     figures["breakdown"] = breakdown_chart(data["breakdown"])
-    return {name: None if fig is None else data_uri(fig) for name, fig in figures.items()}
+    uris = {name: None if fig is None else data_uri(fig) for name, fig in figures.items()}
+    if data.get("cut"):
+        uris["part"] = png_uri(data["cut"]["result"].picture(window_size=(1000, 700)))
+    return uris
+
+
+def png_uri(image: np.ndarray) -> str:
+    """A PNG ``data:`` URI of an image array (height, width, 3)."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(np.asarray(image, np.uint8)).save(buf, format="PNG", optimize=True)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")

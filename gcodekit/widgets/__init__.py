@@ -5,7 +5,9 @@
 - :class:`StageDiff`: two stages of the transpiler (or two programs) side by
   side, changed lines marked, both toolpaths in one picture;
 - :class:`VelocityPlot`: commanded feed against planned speed, decimated,
-  following a viewer's range.
+  following a viewer's range;
+- :class:`PartView`: the part a mill program cuts, in a live 3D view (trame,
+  vtk.js in the browser), with a slider over the moves.
 
 They need the ``widgets`` extra (``pip install 'gcodekit[widgets]'``), load
 on first use (``import gcodekit`` does not import them) and are plain Python
@@ -18,7 +20,8 @@ from __future__ import annotations
 
 from importlib import import_module
 
-_WIDGETS = {"LayerViewer": ".layer_viewer", "StageDiff": ".stage_diff", "VelocityPlot": ".velocity"}
+_WIDGETS = {"LayerViewer": ".layer_viewer", "StageDiff": ".stage_diff", "VelocityPlot": ".velocity",
+            "PartView": ".part_view"}
 
 __all__ = list(_WIDGETS)
 
