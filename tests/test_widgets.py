@@ -15,7 +15,7 @@ import gcodekit  # noqa: E402
 from gcodekit.analysis import layers as waypoint_layers  # noqa: E402
 from gcodekit.widgets import LayerViewer, StageDiff, VelocityPlot  # noqa: E402
 from gcodekit.widgets.checks import check  # noqa: E402
-from gcodekit.widgets.toolpath import Toolpath  # noqa: E402
+from gcodekit.view import Toolpath  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CUBE = ROOT / "examples" / "cube20_prusaslicer_marlin.gcode"

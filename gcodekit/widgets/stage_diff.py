@@ -241,7 +241,7 @@ class StageDiff(PictureDisplay):
         return f'<div class="gcodekit-diff-summary" style="font:12px sans-serif;margin:4px 0">{note}</div>' + "".join(out)
 
     def _source_lines(self) -> list[str]:
-        from .toolpath import source_lines
+        from ..view import source_lines
 
         return source_lines(self.transpiler.op) or []
 
@@ -278,11 +278,10 @@ class StageDiff(PictureDisplay):
                 return message_figure(f"{side.name}: cannot draw its toolpath: {friendly(exc)}")
             w = op.waypoints
             motion = np.asarray(w["motion"])
-            rows = np.flatnonzero((motion > 0) & (np.asarray(w["distance"]) > 0))
-            rows = rows[rows > 0]
-            from .toolpath import _segments
+            from ..view import move_segments, moving_mask
 
-            start, end, move_of = _segments(w, rows)
+            rows = np.flatnonzero(moving_mask(op))
+            start, end, move_of = move_segments(w, rows)
             rapid = motion[rows][move_of] == 1
             # the left stage wide and pale under the right one: where both agree, both stay visible
             width = 3.5 if index == 0 else 1.3
