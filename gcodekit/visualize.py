@@ -136,19 +136,22 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
                                position_x=0.88, position_y=0.1, height=0.8, width=0.04,
                                title_font_size=18, label_font_size=14,
                                fmt="%.0f" if categories else "%.4g")
-    kwargs: dict[str, Any] = dict(scalars=scalars, line_width=line_width, scalar_bar_args=bar,
+    # lines unlit: a segment shows its colour as the other pictures do, whichever way it faces
+    kwargs: dict[str, Any] = dict(scalars=scalars, line_width=line_width, scalar_bar_args=bar, lighting=False,
                                   show_scalar_bar=scalar_bar, cmap=cmap or color.cmap(),
                                   clim=list(color.value_range(path.kind == WORK)))
     if categories:
-        kwargs.update(categories=True, clim=[-0.5, len(categories) - 0.5], n_colors=len(categories),
-                      annotations={k: name for k, name in enumerate(categories)})
+        # one colour per category index, whichever indices the work has (PyVista's categories=True would
+        # number the present values afresh and shift the colours)
+        kwargs.update(clim=[-0.5, len(categories) - 0.5], n_colors=len(categories),
+                      annotations={float(k): name for k, name in enumerate(categories)})
         bar.update(n_labels=0, n_colors=len(categories))
     else:
         kwargs["n_colors"] = 256
     if mesh.n_cells:
         plotter.add_mesh(mesh, **kwargs)
     if show_travel and travel.n_cells:
-        plotter.add_mesh(travel, color=TRAVEL_COLOR, line_width=max(line_width / 2, 1.0))
+        plotter.add_mesh(travel, color=TRAVEL_COLOR, line_width=max(line_width / 2, 1.0), lighting=False)
     if tool_vectors and "tool_vector" in mesh.cell_data:
         lo, hi = path.bounds()
         plotter.add_mesh(_glyphs(pv, mesh, 0.04 * float(np.linalg.norm(hi - lo))), color="#d62728")

@@ -63,7 +63,8 @@ def toolpath_figure(path: "Toolpath", span: tuple[int, int], color: "Coloring", 
 
     a, b = span
     fig = new_figure(size)
-    ax = fig.add_axes((0.0, 0.0, 0.78, 0.94) if title else (0.0, 0.0, 0.78, 1.0))
+    # the view takes the whole height and the title is laid over it, as the browser lays its status over the canvas
+    ax = fig.add_axes((0.0, 0.0, 0.78, 1.0))
     ax.set_axis_off()
     keep = np.arange(a, b)
     if not show_travel:
