@@ -69,4 +69,4 @@ class Camera:
         u, v = (corners - middle) @ right, (corners - middle) @ up
         half = max((v.max() - v.min()) / 2, (u.max() - u.min()) / 2 / aspect, 1e-3 * radius) * (1 + margin)
         target = right * (u.max() + u.min()) / 2 + up * (v.max() + v.min()) / 2
-        return Camera(self.azimuth, self.elevation, radius / half, target.tolist())
+        return Camera(self.azimuth, self.elevation, float(radius / half), [float(v) for v in target])
