@@ -122,6 +122,19 @@ def test_comments_and_file_names_are_escaped(tmp_path):
     assert rows[0]["html"] == "_script_alert_1_.gcode.html"
 
 
+def test_markup_in_feature_names_is_text_on_the_page(tmp_path):
+    """Jinja's autoescape: a slicer feature name holding an element with a handler reaches the page as text."""
+    planted = "<img src=x onerror=alert(1)>"
+    program = tmp_path / "planted.gcode"
+    program.write_text(tiny_print(2).replace(";TYPE:Internal infill", f";TYPE:{planted}"))
+    rows = write_reports([program], tmp_path / "out", options=ReportOptions(pdf=False))
+    page = (tmp_path / "out" / rows[0]["html"]).read_text()
+    assert "&lt;img src=x onerror=alert(1)&gt;" in page  # the breakdown's row label
+    images = re.findall(r"<img\b[^>]*>", page, flags=re.IGNORECASE)
+    assert images and all('src="data:image/png;base64,' in tag for tag in images)  # only the figures
+    assert "onerror" not in "".join(images)
+
+
 def test_empty_program_gets_a_page_without_pictures(tmp_path):
     program = tmp_path / "empty.ngc"
     program.write_text("(nothing to do)\n")
