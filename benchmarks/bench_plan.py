@@ -75,7 +75,7 @@ def child(task: str, path: str, machine: str) -> dict:
     op = gcodekit.gcode_to_operation(Path(path), machine, plan=False)
     t1 = time.perf_counter()
     config = op.machine
-    run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings))
+    op.attach_plan(run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings)))
     t2 = time.perf_counter()
     return {"read_emulate_s": t1 - t0, "plan_s": t2 - t1, "peak_mb": _peak_mb()}
 

@@ -34,12 +34,15 @@ EXPORT_FORMATS = ("csv", "parquet", "vtk", "events")
 _DEFAULT_SUFFIX = {"csv": None, "events": None, "parquet": ".parquet", "vtk": ".vtp"}
 
 
-class UsageError(ValueError):
+class UsageError(ConfigError):
     """A command-line argument that cannot work (exit status 2)."""
 
 
 def _parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     p = argparse.ArgumentParser(prog="gcodekit", description="Read, emulate and summarise G-code programs.")
+    p.add_argument("--version", action="version", version=f"gcodekit {__version__}")
     debug = argparse.ArgumentParser(add_help=False)
     debug.add_argument("--debug", action="store_true",
                        help="on an internal error, print the traceback (for a bug report)")
@@ -55,8 +58,8 @@ def _parser() -> argparse.ArgumentParser:
     export.add_argument("file", metavar="FILE")
     _common(export)
     export.add_argument("--to", choices=EXPORT_FORMATS, default="csv",
-                        help="csv or parquet: one row per motion; vtk: the deposition paths of an additive program "
-                             "(.vtp or .vtk); events: the Abaqus AM event series (default: csv)")
+                        help="csv or parquet: one row per motion; vtk: the deposition paths of an additive program, "
+                             "the toolpath of any other (.vtp or .vtk); events: the Abaqus AM event series (default: csv)")
     export.add_argument("--source", choices=("material", "heat"), default="material",
                         help="events: material deposition or the laser/weld heat source (default: material)")
     export.add_argument("-o", "--output", metavar="OUT",
@@ -308,13 +311,13 @@ def _export(args: argparse.Namespace) -> int:
         from .additive import AdditivePart
         from .export.vtk import VTKExporter
 
-        if op.machine.process != "additive":
-            raise UsageError(f"{args.file}: VTK export is for additive programs; machine {op.machine.name!r} "
-                             f"is {op.machine.process}")
-        part = AdditivePart(op)
-        if part.depositions.empty:
-            raise NothingToShowError(f"{args.file}: no deposition moves to export")
-        VTKExporter.additive_part_to_vtk(part, output)
+        if op.process != "additive":
+            VTKExporter.toolpath_to_vtk(op, output)
+        else:
+            part = AdditivePart(op)
+            if part.depositions.empty:
+                raise NothingToShowError(f"{args.file}: no deposition moves to export")
+            VTKExporter.additive_part_to_vtk(part, output)
     _report_errors(op)
     return 0
 

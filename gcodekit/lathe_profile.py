@@ -2,7 +2,7 @@
 
 G70-G72 cut along a profile the program writes as a subroutine, named by
 the cycle's ``Q`` word.  rs274 reads that subroutine when the cycle runs,
-so the preprocess stage (:mod:`gcodekit.preprocess.flow.profile`) runs it
+so the preprocess stage (:mod:`gcodekit.preprocess.flow.lathe_profile_capture`) runs it
 there and attaches what it read to the cycle's line as a
 :class:`LatheProfile`.  The read stage carries it with the line's blocks,
 the parse stage keeps it by row (``CommandTable.profiles``, and

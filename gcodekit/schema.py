@@ -2,10 +2,11 @@
 
 After emulation the truth about a program is a table of waypoints: one row
 per command (its end state) plus the points commands pass through.  The
-machine fills the :data:`WAYPOINT_COLUMNS`; the planner and the operation
-add the :data:`DERIVED_COLUMNS`.  ``Operation.columns`` and the DataFrames
-show the same schema, so a user can look up what a column is and in what
-unit.
+machine fills the :data:`WAYPOINT_COLUMNS` and ``command`` (which command
+made each waypoint); the DataFrames add the :data:`COMMAND_COLUMNS` of that
+command, and the planner and the operation the :data:`DERIVED_COLUMNS`.
+``Operation.columns`` and the DataFrames show the same schema, so a user can
+look up what a column is and in what unit.
 
 Examples
 --------
@@ -19,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Column", "WAYPOINT_COLUMNS", "DERIVED_COLUMNS", "COLUMNS", "allocate"]
+__all__ = ["Column", "COMMAND_COLUMNS", "WAYPOINT_COLUMNS", "DERIVED_COLUMNS", "COLUMNS", "allocate"]
 
 
 @dataclass(frozen=True)
@@ -31,6 +32,14 @@ class Column:
     dtype: str
     meaning: str
 
+
+#: Columns that say which command made a waypoint; the machine writes ``command``, the DataFrames the rest.
+COMMAND_COLUMNS: tuple[Column, ...] = (
+    Column("line", "", "int32", "source line of the command (1-based, in the file the user gave)"),
+    Column("command", "", "int64", "row in op.commands of the command that made the waypoint"),
+    Column("code", "", "str", "the command's code as written (G1, M104, a named command's name)"),
+    Column("kind", "", "category", "the command's kind (motion, setting, ...)"),
+)
 
 #: Columns the machine writes for every waypoint (machine coordinates, all offsets applied).
 WAYPOINT_COLUMNS: tuple[Column, ...] = (
@@ -63,7 +72,7 @@ WAYPOINT_COLUMNS: tuple[Column, ...] = (
 DERIVED_COLUMNS: tuple[Column, ...] = (
     Column("layer", "", "int32", "layer of the waypoint, 0 first (-1 before the first); one definition, "
                                  "see gcodekit.model.derived"),
-    Column("feature", "", "object", "slicer feature (;TYPE: comment) or DED fraction in force; '' when none"),
+    Column("feature", "", "str", "slicer feature (;TYPE: comment) or DED fraction in force; '' when none"),
     Column("depositing", "", "bool", "the step lays material"),
     Column("elapsed_time", "s", "float64", "time from the program's start to the end of the step"),
     Column("start_time", "s", "float64", "time from the program's start to the start of the step"),
@@ -71,11 +80,16 @@ DERIVED_COLUMNS: tuple[Column, ...] = (
     Column("cruise_v", "mm/s", "float64", "fastest planned cruise speed of the step"),
     Column("end_v", "mm/s", "float64", "planned speed leaving the step (last firmware move)"),
     Column("accel", "mm/s^2", "float64", "acceleration the planner used for the step's first move"),
+    Column("deposited_volume", "mm^3", "float64", "material laid by the step (additive processes; NaN when "
+                                                   "the machine does not say how much)"),
 )
 
-COLUMNS: dict[str, Column] = {c.name: c for c in WAYPOINT_COLUMNS + DERIVED_COLUMNS}
+COLUMNS: dict[str, Column] = {c.name: c for c in COMMAND_COLUMNS + WAYPOINT_COLUMNS + DERIVED_COLUMNS}
 
 
 def allocate(n: int) -> dict[str, np.ndarray]:
-    """Empty arrays for ``n`` waypoints, one per :data:`WAYPOINT_COLUMNS` entry, in order."""
-    return {c.name: np.empty(n, c.dtype) for c in WAYPOINT_COLUMNS}
+    """Empty arrays for ``n`` waypoints, one per :data:`WAYPOINT_COLUMNS` entry, in order, and
+    ``command``: at first one waypoint per command."""
+    out = {c.name: np.empty(n, c.dtype) for c in WAYPOINT_COLUMNS}
+    out["command"] = np.arange(n, dtype=np.int64)
+    return out

@@ -68,7 +68,7 @@ def assert_operations_equal(actual: "Operation", expected: "Operation", *, rtol:
         return
     if wa["x"].size != wb["x"].size:
         raise AssertionError(f"{wa['x'].size} waypoints != {wb['x'].size} waypoints")
-    rows = np.asarray(wa["command"]) if "command" in wa else np.arange(wa["x"].size)
+    rows = np.asarray(wa["command"])
     for column in WAYPOINT_COLUMNS:
         if column.name == "time" and not check_time:
             continue

@@ -25,8 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .errors import NothingToShowError
-from .view import TRAVEL, TRAVEL_COLOR, WORK, Camera, Coloring, Toolpath, coloring, default_coloring, \
-    is_additive
+from .view import TRAVEL, TRAVEL_COLOR, WORK, Camera, Coloring, Toolpath, coloring, default_coloring
 
 if TYPE_CHECKING:
     import pyvista as pv
@@ -127,7 +126,7 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
     color = coloring(path, scalars)
     mesh, travel = toolpath_polydata(path, color)
     if mesh.n_cells == 0 and (travel.n_cells == 0 or not show_travel):
-        raise NothingToShowError(f"{op.file}: nothing to draw (no {'deposition' if is_additive(op) else 'feed'} "
+        raise NothingToShowError(f"{op.file}: nothing to draw (no {'deposition' if op.process == 'additive' else 'feed'} "
                                  "moves)")
     plotter = pv.Plotter(off_screen=off_screen, window_size=list(window_size))
     plotter.set_background(background)

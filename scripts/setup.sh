@@ -12,6 +12,8 @@ PY=${PYTHON:-python3}
 
 die() { echo "gcodekit setup: $*" >&2; exit 1; }
 
+source "$ROOT/scripts/apt.sh"
+
 command -v "$PY" >/dev/null || die "$PY not found; install Python 3.11 or newer (apt-get install python3)"
 "$PY" -c 'import sys; sys.exit(sys.version_info < (3, 11))' || die "Python 3.11 or newer is needed, found $("$PY" -V)"
 
@@ -19,8 +21,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   if ! "$PY" -m venv "$VENV" 2>/dev/null; then
     rm -rf "$VENV"
     if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
-      echo "gcodekit setup: installing python3-venv with apt-get" >&2
-      { apt-get update -qq && apt-get install -y -qq python3-venv >/dev/null; } || die "apt-get could not install python3-venv"
+      apt_install "virtual environments" python3-venv
       "$PY" -m venv "$VENV" || die "cannot create a virtual environment in $VENV"
     else
       die "cannot create a virtual environment; install the python3-venv package"
@@ -39,9 +40,7 @@ command -v chromium >/dev/null || command -v chromium-browser >/dev/null || comm
 command -v pdftoppm >/dev/null || missing+=(poppler-utils)
 if [ ${#missing[@]} -gt 0 ]; then
   if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
-    echo "gcodekit setup: installing ${missing[*]} with apt-get" >&2
-    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null; } \
-      || die "apt-get could not install ${missing[*]}"
+    apt_install "pictures and PDF reports" "${missing[@]}"
   else
     die "pictures and PDF reports need ${missing[*]}: install them (apt-get install ${missing[*]}) as root, then run this again"
   fi
@@ -51,10 +50,7 @@ fi
 # differential tests run against; without it they skip, so only the test command asks for it.
 if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -x /usr/bin/rs274 ]; then
   if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
-    echo "gcodekit setup: installing linuxcnc-uspace (LinuxCNC's rs274) with apt-get" >&2
-    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-        linuxcnc-uspace >/dev/null; } \
-      || die "apt-get could not install linuxcnc-uspace (LinuxCNC's rs274, the reference of the differential tests)"
+    apt_install "LinuxCNC's rs274, the reference of the differential tests" --no-install-recommends linuxcnc-uspace
   else
     die "the differential tests need LinuxCNC's rs274: install it as root (apt-get install --no-install-recommends linuxcnc-uspace), then run this again"
   fi

@@ -103,3 +103,14 @@ def test_bad_input_and_bad_arguments_have_their_own_statuses(tmp_path, capsys):
     bad.write_text("G21\nG2 X10 Y0 R1 F100\nM2\n")
     status, _, err = run(["export", bad, "--to", "csv", "--strict"], capsys)
     assert status == cli.EXIT_PROGRAM_ERROR and f"{bad}:2:" in err
+
+
+def test_version_prints_the_package_version(capsys):
+    import pytest
+
+    import gcodekit
+
+    with pytest.raises(SystemExit) as stop:
+        cli.main(["--version"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"gcodekit {gcodekit.__version__}"

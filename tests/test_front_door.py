@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 
 import numpy as np
@@ -42,13 +44,24 @@ def test_new_waypoints_forget_the_old_derived_columns():
 def test_columns_document_every_dataframe_column(cube):
     frame = cube.to_dataframe()
     schema = cube.columns
-    documented = [c for c in frame.columns if c in COLUMNS]
-    assert set(schema.index) >= set(documented) and set(documented) >= set(schema.index) - {"accel"}
+    assert set(frame.columns) <= set(COLUMNS), set(frame.columns) - set(COLUMNS)  # every column is in the schema
+    assert set(schema.index) >= set(frame.columns) >= set(schema.index) - {"accel"}
     assert schema.loc["x", "unit"] == "mm" and schema.loc["elapsed_time", "unit"] == "s"
-    for name in documented:
-        if name in ("motion", "feature"):
-            continue  # categorical / object in the frame
+    for name in frame.columns:
+        if name == "motion":
+            continue  # the waypoints' uint8 code, a categorical of its names in the frame
         assert str(frame[name].dtype) == schema.loc[name, "dtype"], name
+
+
+@pytest.mark.parametrize("program, machine", [("bracket_mill.ngc", None), ("dome_ded_beckhoff.nc", None),
+                                              ("cead_wall.mpf", None), ("baam_wall.nc", None)])
+def test_every_column_a_stage_makes_is_in_the_schema(program, machine):
+    op = gcodekit.gcode_to_operation(EXAMPLES / program, machine)
+    for name, values in op.waypoints.items():
+        assert name in COLUMNS, name
+        assert values.dtype == np.dtype(COLUMNS[name].dtype), name
+    frame = op.to_dataframe()
+    assert set(frame.columns) <= set(COLUMNS), set(frame.columns) - set(COLUMNS)
 
 
 def test_the_one_summary_record_is_what_info_prints(cube, capsys):
@@ -90,3 +103,28 @@ def test_seed_names_are_kept():
     from gcodekit.analysis import depositing, features, layers  # where users looked for them
 
     assert layers is gcodekit.model.derived.layers and callable(depositing) and callable(features)
+
+
+# -- process behaviour lives on the process classes -------------------------------------------------------
+
+
+def test_each_process_answers_what_it_deposits_works_and_moves():
+    from gcodekit.model import AdditiveOperation, SubtractiveOperation
+
+    printed = gcodekit.gcode_to_operation("M83\nG1 Z0.2 F600\nG1 X10 E1\nG1 X20 E-0.5\nG0 X30\n", "marlin", plan=False)
+    assert isinstance(printed, AdditiveOperation) and printed.process == "additive"
+    assert printed.moving.tolist() == [False, True, True, True, True]  # M83 moves nothing
+    assert printed.depositing.tolist() == [False, False, True, False, False]
+    assert printed.work.tolist() == [False, False, True, False, False]
+    area = math.pi * 1.75**2 / 4
+    assert printed.volumes() == pytest.approx([0.0, 0.0, area, -0.5 * area, 0.0])  # a retraction draws back
+    assert printed.get_bounds("extrude") == {"min": [0.0, 0.0, 0.2], "max": [10.0, 0.0, 0.2]}
+
+    milled = gcodekit.gcode_to_operation("G21 G90\nG0 X5\nG1 X10 F300\nG1 X10\n", "linuxcnc", plan=False)
+    assert isinstance(milled, SubtractiveOperation) and milled.process == "subtractive"
+    assert milled.moving.tolist() == [False, False, True, True, False]  # the last move goes nowhere
+    assert milled.work.tolist() == [False, False, False, True, False]
+    assert not milled.depositing.any()
+    assert np.isnan(milled.volumes()).all()  # until a cutting simulation says what each move removes
+    assert milled.get_bounds("extrude") is None
+    assert milled.get_bounds("feed") == {"min": [5.0, 0.0, 0.0], "max": [10.0, 0.0, 0.0]}

@@ -35,7 +35,7 @@ def test_case_totals_within_a_millisecond(case):
         import dataclasses
 
         settings = dataclasses.replace(settings, **options)
-    run_planner(op, "klipper", settings)
+    op.attach_plan(run_planner(op, "klipper", settings))
     assert op.get_statistics()["time_s"] == pytest.approx(TOTALS[case], abs=1e-3)
 
 

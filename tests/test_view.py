@@ -17,7 +17,7 @@ import pytest
 
 import gcodekit
 from gcodekit.view import (CHORD_ANGLE_DEG, PALETTE, TRAVEL, WORK, Camera, Toolpath, ToolpathError, coloring,
-                           is_additive, move_masks, source_lines)
+                           move_masks, source_lines)
 
 #: A square, then a half circle; line k of the text is PROGRAM_LINES[k - 1].
 PROGRAM_LINES = ["G21 G90 G17", "G0 X0 Y0 Z1", "G1 Z0 F300", "G1 X10 F600 (side one)", "G1 Y10 (side two)",
@@ -28,7 +28,7 @@ PROGRAM = "\n".join(PROGRAM_LINES) + "\n"
 def test_segments_groups_and_lines_by_hand():
     op = gcodekit.gcode_to_operation(PROGRAM, "linuxcnc", plan=False)
     path = Toolpath.of(op)
-    assert not is_additive(op) and path.group_by == "z"
+    assert op.process != "additive" and path.group_by == "z"
     # moves: the rapid to Z1, the plunge (feed: work), two sides, the half circle, the retract (rapid)
     assert [path.line_of(k) for k in range(len(path.move_rows))] == [2, 3, 4, 5, 6, 7]
     chords = int(np.ceil(180 / CHORD_ANGLE_DEG))

@@ -92,3 +92,66 @@ def test_arcs_become_polylines_as_long_as_the_arcs(shared_dir, tmp_path):
     lengths = _cell_lengths(mesh)
     assert lengths.sum() == pytest.approx(part.deposition_length, rel=1e-3)
     assert lengths == pytest.approx(part.depositions["length"].to_numpy(), rel=2e-3, abs=1e-6)
+
+
+# -- the toolpath of a program that lays no material --------------------------------------------------
+
+MILL_PROGRAM = """G21 G90 G17
+T2 M6
+G0 X10 Y0 Z5
+G1 Z-1 F300
+G3 X0 Y10 I-10 J0 F600
+G1 X-5
+G0 Z5
+"""
+
+
+def _cells(mesh):
+    cells, k, out = mesh.lines, 0, []
+    while k < cells.size:
+        out.append(cells[k + 1:k + 1 + cells[k]])
+        k += cells[k] + 1
+    return out
+
+
+def test_a_mill_toolpath_is_cells_of_rapids_and_feeds_with_arcs_drawn():
+    op = gcodekit.gcode_to_operation(MILL_PROGRAM, machine="linuxcnc", plan=False)
+    mesh = op.to_vtk()
+    # G0 (rapid), then Z-1 + arc + X-5 (one feed run), then the rapid up
+    assert mesh.cell_data["rapid"].tolist() == [1, 0, 1]
+    arc = 10 * math.pi / 2  # a quarter turn of radius 10, counter-clockwise
+    assert mesh.cell_data["length"] == pytest.approx([math.hypot(10, 5), 6 + arc + 5, 6])
+    assert _cell_lengths(mesh)[1] == pytest.approx(6 + arc + 5, rel=2e-3)  # chords 5 degrees apart
+    feed_cell = mesh.points[_cells(mesh)[1]]
+    on_arc = feed_cell[1:-1]
+    assert np.hypot(on_arc[:, 0], on_arc[:, 1]) == pytest.approx(10.0)
+    assert mesh.cell_data["tool"].tolist() == [2, 2, 2]
+    assert mesh.cell_data["start_line"].tolist() == [3, 4, 7]
+    feeds = mesh.point_data["feed"][_cells(mesh)[1]]
+    assert feeds[1] == 300 and feeds[-1] == 600  # the plunge's feed, then the arc's
+    assert "tool_vector" not in mesh.point_data
+
+
+def test_a_mill_toolpath_carries_the_tool_direction_when_rotary_axes_turn():
+    op = gcodekit.gcode_to_operation("G21 G90\nG1 X10 A0 F600\nG1 X20 A90\n", machine="linuxcnc", plan=False)
+    mesh = op.to_vtk()
+    assert mesh.point_data["tool_vector"][-1] == pytest.approx([0.0, -1.0, 0.0], abs=1e-12)
+    assert mesh.point_data["tool_vector"][0] == pytest.approx([0.0, 0.0, 1.0])
+
+
+def test_a_mill_toolpath_writes_vtp_and_refuses_options(tmp_path):
+    op = gcodekit.gcode_to_operation(EXAMPLES / "bracket_mill.ngc")
+    op.to_vtk(tmp_path / "bracket.vtp")
+    back = pv.read(tmp_path / "bracket.vtp")
+    assert back.n_cells == op.to_vtk().n_cells > 0
+    assert back.cell_data["length"].sum() == pytest.approx(np.asarray(op.waypoints["distance"])[op.moving].sum())
+    with pytest.raises(TypeError, match="takes no options"):
+        op.to_vtk(bead="rectangle")
+
+
+def test_a_program_that_never_moves_has_nothing_to_export():
+    from gcodekit.errors import NothingToShowError
+
+    op = gcodekit.gcode_to_operation("G21\nM5\n", machine="linuxcnc", plan=False)
+    with pytest.raises(NothingToShowError, match="no move"):
+        op.to_vtk()

@@ -126,15 +126,14 @@ class AdditivePart:
         length = per_segment(w["distance"])
         filament = per_segment(w["de"])
         start_time = elapsed[start] - np.nan_to_num(np.asarray(w["time"], float)[start])
-        command = w.get("command")  # waypoint -> command row, when some command made extra waypoints
+        command = w["command"]
         # material laid before the first layer is start code's (purge lines), not the part's
         kind = np.where(deposit[first_move], np.where(self.waypoint_layer[start] >= 0, "deposition", "purge"),
                         "travel") if first_move.size else np.zeros(0, str)
         frame = pd.DataFrame({
             "kind": pd.Categorical(kind, categories=["deposition", "travel", "purge"]),
             "start": start, "end": end,
-            "start_command": start if command is None else command[start],
-            "end_command": end if command is None else command[end],
+            "start_command": command[start], "end_command": command[end],
             "moves": last_move - first_move + 1,
             "layer": self.waypoint_layer[start], "length": length,
             "start_time": start_time, "end_time": elapsed[end], "time": elapsed[end] - start_time,

@@ -166,7 +166,7 @@ class Machine:
 
         The returned dict holds the arrays of
         :data:`gcodekit.schema.WAYPOINT_COLUMNS` and ``command`` (row of the command each
-        waypoint belongs to) when some command added waypoints.
+        waypoint belongs to).
         """
         table = self._part_frame(self._radius_words(table))
         n = len(table)
@@ -570,7 +570,9 @@ def _with_extra_waypoints(out: dict, extra: list, n: int) -> dict:
         return out
     rows = np.array([r for r, _ in extra])
     for key, arr in out.items():
+        if key == "command":
+            out[key] = np.insert(arr, rows, rows).astype(np.int64)
+            continue
         values = [w.values.get(key, arr[r]) if r < n else 0 for r, w in extra]
         out[key] = np.insert(arr, rows, np.array(values, dtype=arr.dtype))
-    out["command"] = np.insert(np.arange(n), rows, rows).astype(np.int64)
     return out

@@ -22,10 +22,11 @@ from __future__ import annotations
 
 import math
 
+from ..errors import GcodeMachineError
 from ..limits import MotionBudget
 
 
-class ThreadingError(ValueError):
+class ThreadingError(GcodeMachineError):
     """A G76 block the cycle refuses; the message is rs274's."""
 
 

@@ -6,24 +6,19 @@ import numpy as np
 
 from ..emulate import arcs
 
-_SELECT = {
-    "motion": lambda w: w["motion"] > 0,
-    "feed": lambda w: w["motion"] >= 2,
-    "extrude": lambda w: (w["motion"] > 0) & (w["de"] > 0),
-}
+def toolpath_bounds(w: dict[str, np.ndarray], selected: np.ndarray, *,
+                    with_starts: bool = False) -> dict[str, list[float]] | None:
+    """Bounds of the moves ``selected`` (a mask over the waypoints; see :meth:`Operation.get_bounds`).
 
-
-def toolpath_bounds(w: dict[str, np.ndarray], which: str = "motion") -> dict[str, list[float]] | None:
-    """Bounds of the selected moves (see :meth:`Operation.get_bounds`)."""
-    from ..errors import check_choice
-
-    check_choice("which", which, _SELECT)
-    sel = np.flatnonzero(_SELECT[which](w))
+    ``with_starts`` counts where each selected move starts as well as where it
+    ends (the previous waypoint); arcs count with their full sweep.
+    """
+    sel = np.flatnonzero(selected)
     if sel.size == 0:
         return None
     xyz = np.column_stack([w["x"], w["y"], w["z"]])
     points = [xyz[sel]]
-    if which != "motion":  # a cut or a bead starts where the previous step ended
+    if with_starts:
         starts = sel[sel > 0] - 1
         points.append(xyz[starts])
     arc_rows = sel[w["motion"][sel] >= 3]

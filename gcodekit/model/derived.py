@@ -28,18 +28,22 @@ import numpy as np
 if TYPE_CHECKING:
     from .operation import Operation
 
-__all__ = ["depositing", "depositing_of", "screw_extruder", "features", "layers", "waypoint_rows", "row_labels"]
+__all__ = ["moving", "depositing", "depositing_of", "screw_extruder", "features", "layers", "waypoint_rows", "row_labels"]
+
+
+def moving(w: dict) -> np.ndarray:
+    """Waypoints that move the tool: a motion of some length (a move to where the tool already is does not)."""
+    return (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
 
 
 def depositing(w: dict, screw: bool = False) -> np.ndarray:
     """Waypoints that lay material: filament pushed on a move (FFF), a feed
     move with the heat source on (DED, where the wire or powder has no E), or
     with ``screw``, a feed move while the screw extruder turns (BAAM, CEAD)."""
-    moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
     feeding = np.asarray(w["motion"]) >= 2
     welding = (np.asarray(w["laser"]) == 1) & feeding if "laser" in w else False
     turning = (np.asarray(w["spindle"]) > 0) & feeding if screw else False
-    return moving & ((np.asarray(w["de"]) > 0) | welding | turning)
+    return moving(w) & ((np.asarray(w["de"]) > 0) | welding | turning)
 
 
 def screw_extruder(op: "Operation") -> bool:
@@ -55,7 +59,7 @@ def depositing_of(op: "Operation") -> np.ndarray:
 def waypoint_rows(op: "Operation") -> np.ndarray:
     """The command row of each waypoint."""
     w = op.waypoints
-    return w["command"] if "command" in w else np.arange(len(op.table))
+    return w["command"]
 
 
 def row_labels(op: "Operation", pattern: str) -> tuple[np.ndarray, list[str]]:
@@ -106,7 +110,7 @@ def layers(op: "Operation", heights: np.ndarray | None = None) -> np.ndarray:
         if (marks >= 0).any():
             return marks[waypoint_rows(op)]
         heights = op.waypoints["z"]
-    extruding = np.flatnonzero(depositing_of(op))
+    extruding = np.flatnonzero(op.depositing)
     z = np.round(np.asarray(heights, float), 4)
     at = z[extruding]
     starts = extruding[np.r_[True, at[1:] != at[:-1]]] if extruding.size else extruding

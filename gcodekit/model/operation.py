@@ -37,6 +37,8 @@ if TYPE_CHECKING:
     import pandas as pd
 
     from ..emulate.presets import MachineConfig
+    from ..plan import Plan
+    from ..plan.moves import PlannedMoves, PlanResult
     from ..syntax import Flavor
 
 
@@ -61,6 +63,8 @@ class Operation:
     """
 
     process_data_class: type[ProcessData] = ProcessData
+    #: The kind of process, as machine presets name it: ``"additive"``, ``"subtractive"`` or ``"generic"``.
+    process: str = "generic"
 
     def __init__(self, commands: CommandTable, waypoints: dict[str, np.ndarray] | None = None, *,
                  file: str = "<string>", flavor: "Flavor | None" = None,
@@ -75,8 +79,7 @@ class Operation:
         self.machine = machine
         self.diagnostics = diagnostics if diagnostics is not None else Diagnostics(file)
         self.n_lines = n_lines
-        self._elapsed: np.ndarray | None = None
-        self.plan = None  # (PlannedMoves, PlanResult) once a motion planner has run
+        self.plan: tuple[PlannedMoves, PlanResult] | None = None  # once a motion planner has run
 
     @property
     def waypoints(self) -> dict[str, np.ndarray] | None:
@@ -94,6 +97,21 @@ class Operation:
         if name not in self._derived:
             self._derived[name] = make()
         return self._derived[name]
+
+    @property
+    def moving(self) -> np.ndarray:
+        """Per waypoint, whether it moves the tool (a motion of some length; see :mod:`gcodekit.model.derived`)."""
+        return self._kept("moving", lambda: derived.moving(self.waypoints))
+
+    @property
+    def work(self) -> np.ndarray:
+        """Per waypoint, whether the move does the process's work: what pictures draw as the part.
+
+        Feed moves (G1-G3 and the like) of some length here; an additive
+        operation's depositing moves from the first layer on.  The other
+        moves are travel.
+        """
+        return self._kept("work", lambda: self.moving & (np.asarray(self.waypoints["motion"]) >= 2))
 
     @property
     def depositing(self) -> np.ndarray:
@@ -170,7 +188,7 @@ class Operation:
         columns = self._process_columns()
 
         def make(i: int) -> ProcessData:
-            k = i if mapping is None else int(mapping[i])
+            k = int(mapping[i])
             return self.process_data_class(**self._process_fields(k, columns))
 
         return LazyList(len(self.table), make)
@@ -186,11 +204,9 @@ class Operation:
         state = "emulated" if self.emulated else "not emulated"
         return f"<{type(self).__name__} {self.file!r}: {len(self)} commands, {state}>"
 
-    def _waypoint_of_command(self) -> np.ndarray | None:
-        """Index of each command's own (last) waypoint, or None when one each."""
-        cmd = self.waypoints.get("command") if self.waypoints else None
-        if cmd is None:
-            return None
+    def _waypoint_of_command(self) -> np.ndarray:
+        """Index of each command's own (last) waypoint."""
+        cmd = self.waypoints["command"]
         last = np.r_[cmd[1:] != cmd[:-1], True]
         return np.flatnonzero(last)
 
@@ -211,9 +227,13 @@ class Operation:
 
     def elapsed_time(self) -> np.ndarray:
         """Time at the end of each waypoint, s (NaN steps count as zero)."""
-        if self._elapsed is None:
-            self._elapsed = np.cumsum(np.nan_to_num(self.waypoints["time"]))
-        return self._elapsed
+        return self._kept("elapsed_time", lambda: np.cumsum(np.nan_to_num(self.waypoints["time"])))
+
+    def attach_plan(self, plan: "Plan") -> None:
+        """Take a motion planner's result: its per-waypoint ``time`` and, as :attr:`plan`, the per-move plan."""
+        self.waypoints["time"] = plan.time
+        self.plan = (plan.moves, plan.result)
+        self._derived.pop("elapsed_time", None)
 
     # -- summaries ----------------------------------------------------------------
 
@@ -240,9 +260,14 @@ class Operation:
         """
         if not self._require_emulation("get_bounds()"):
             return None
+        from ..errors import check_choice
         from .bounds import toolpath_bounds
 
-        return toolpath_bounds(self.waypoints, which)
+        check_choice("which", which, ("motion", "feed", "extrude"))
+        motion = np.asarray(self.waypoints["motion"])
+        selected = {"motion": motion > 0, "feed": motion >= 2, "extrude": self.depositing}[which]
+        # a cut or a bead starts where the previous step ended
+        return toolpath_bounds(self.waypoints, selected, with_starts=which != "motion")
 
     def get_statistics(self) -> dict[str, Any] | None:
         """Counts, distances, time and (additive) layers and filament.
@@ -287,20 +312,24 @@ class Operation:
 
         return plot_operation(self, scalars, **options)
 
-    def to_vtk(self, path: str | os.PathLike | None = None, **options):
-        """The deposition paths as a PyVista mesh, written to ``path`` (``.vtp``/``.vtk``) when given.
+    def volumes(self) -> np.ndarray:
+        """Material each waypoint moves, mm^3: laid (additive) or removed (subtractive); NaN where unknown."""
+        return np.full(len(self.waypoints["x"]), np.nan)
 
-        Builds an :class:`~gcodekit.additive.AdditivePart` (``options`` such as
-        ``bead=`` and ``layer_normal=`` go to it) and exports it with
-        :class:`~gcodekit.export.vtk.VTKExporter`.
+    def to_vtk(self, path: str | os.PathLike | None = None, **options):
+        """The toolpath as a PyVista mesh of poly-lines, written to ``path`` (``.vtp``/``.vtk``) when given.
+
+        See :meth:`gcodekit.export.vtk.VTKExporter.toolpath_to_polydata` for
+        the cells and their data (feed, speed, tool, source line, tool
+        direction); an additive operation writes its deposition paths instead.
         """
-        from ..additive import AdditivePart
         from ..export.vtk import VTKExporter
 
-        part = AdditivePart(self, **options)
+        if options:
+            raise TypeError(f"to_vtk() of a {self.process} operation takes no options, not {', '.join(options)}")
         if path is not None:
-            VTKExporter.additive_part_to_vtk(part, path)
-        return VTKExporter.additive_part_to_polydata(part)
+            VTKExporter.toolpath_to_vtk(self, path)
+        return VTKExporter.toolpath_to_polydata(self)
 
     def to_gcode(self, flavor: str = "rs274ngc") -> str:
         """The commands written back as G-code of ``flavor`` (see :class:`gcodekit.export.gcode.GcodeExporter`)."""
@@ -325,8 +354,7 @@ class Operation:
                 frame[letter] = t.param(letter)
             return frame
         w = self.waypoints
-        cmd = w.get("command")
-        rows = np.arange(len(t)) if cmd is None else cmd
+        rows = w["command"]
         data = {"line": t.line[rows], "command": rows, "code": self._codes()[rows], "kind": self._kinds()[rows]}
         for column in WAYPOINT_COLUMNS:
             data[column.name] = w[column.name]
@@ -334,7 +362,7 @@ class Operation:
         if getattr(self, "plan", None) is not None:
             from ..plan import waypoint_speeds
 
-            data.update(waypoint_speeds(self))
+            data.update(waypoint_speeds(self.plan, len(w["x"])))
         data["elapsed_time"] = self.elapsed_time()
         data["start_time"] = data["elapsed_time"] - np.nan_to_num(np.asarray(w["time"], float))
         data["layer"], data["feature"], data["depositing"] = self.layers, self.features, self.depositing
@@ -380,8 +408,7 @@ class Operation:
             return pd.DataFrame()
         w = self.waypoints
         moved = np.flatnonzero(w["motion"] > 0)
-        cmd = w.get("command")
-        rows = moved if cmd is None else cmd[moved]
+        rows = w["command"][moved]
         inch = w["units"][moved] == 1
         scale = np.where(inch, 1.0 / MM_PER_INCH, 1.0)
         frame = {"line": self.table.line[rows],
@@ -401,7 +428,7 @@ class Operation:
         if getattr(self, "plan", None) is not None:  # planned by the machine's firmware model
             from ..plan import waypoint_speeds
 
-            for key, values in waypoint_speeds(self).items():
+            for key, values in waypoint_speeds(self.plan, len(w["x"])).items():
                 if key != "accel":
                     frame[key] = values[moved] * scale
         return pd.DataFrame(frame)

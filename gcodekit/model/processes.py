@@ -7,6 +7,7 @@ spindle speed.
 
 from __future__ import annotations
 
+import os
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -26,6 +27,32 @@ class AdditiveOperation(Operation):
     """An Operation of a deposition process (FFF, LFAM, DED)."""
 
     process_data_class = AdditiveProcessData
+    process = "additive"
+
+    @property
+    def work(self) -> np.ndarray:
+        """Per waypoint, whether it lays the part: depositing from the first layer on (start-code purge lines
+        are not the part)."""
+        return self._kept("work", lambda: self.depositing & (self.layers >= 0))
+
+    def volumes(self) -> np.ndarray:
+        """Material laid by each waypoint, mm^3 (see :meth:`deposited_volumes`)."""
+        return self.deposited_volumes()
+
+    def to_vtk(self, path: str | os.PathLike | None = None, **options):
+        """The deposition paths as a PyVista mesh, written to ``path`` (``.vtp``/``.vtk``) when given.
+
+        Builds an :class:`~gcodekit.additive.AdditivePart` (``options`` such as
+        ``bead=`` and ``layer_normal=`` go to it) and exports it with
+        :meth:`~gcodekit.export.vtk.VTKExporter.additive_part_to_polydata`.
+        """
+        from ..additive import AdditivePart
+        from ..export.vtk import VTKExporter
+
+        part = AdditivePart(self, **options)
+        if path is not None:
+            VTKExporter.additive_part_to_vtk(part, path)
+        return VTKExporter.additive_part_to_polydata(part)
 
     def to_dataframe(self) -> "pd.DataFrame":
         """As :meth:`Operation.to_dataframe`, plus ``deposited_volume`` (mm^3,
@@ -43,23 +70,23 @@ class AdditiveOperation(Operation):
     def deposited_volumes(self) -> np.ndarray:
         """Material laid by each waypoint (mm^3).
 
-        Filament machines: E pushed times the filament's cross-section.  Screw
-        extruders (BAAM): rpm x minutes x the screw's displacement per
-        revolution while the screw turns on a feed move; NaN when the machine
-        does not give its displacement.  Bead extruders (CEAD): the
-        programmed bead's width x height x the move's length while
-        deposition is on (``EM=1``).  Wire and powder (DED): unknown, NaN.
+        Filament machines: E pushed times the filament's cross-section (a
+        retraction counts negative).  Screw extruders (BAAM): rpm x minutes x
+        the screw's displacement per revolution on each depositing move; NaN
+        when the machine does not give its displacement.  Bead extruders
+        (CEAD): the programmed bead's width x height x the move's length on
+        each depositing move.  Wire and powder (DED): unknown, NaN.  Which
+        moves deposit is :attr:`depositing`.
         """
         w = self.waypoints
         kind = self.machine.extruder_type if self.machine else "filament"
         if kind == "filament":
             return np.asarray(w["de"], float) * self.filament_area
+        on = self.depositing
         if kind == "screw":
-            turning = (np.asarray(w["spindle"]) > 0) & (np.asarray(w["motion"]) >= 2)
             per_rev = self.machine.screw_displacement * 1000.0 or np.nan  # cm^3 -> mm^3
             minutes = np.nan_to_num(np.asarray(w["time"], float)) / 60.0
-            return np.where(turning, np.asarray(w["spindle"], float) * minutes * per_rev, 0.0)
-        on = (np.asarray(w.get("laser", np.zeros(len(w["x"])))) == 1) & (np.asarray(w["motion"]) >= 2)
+            return np.where(on, np.asarray(w["spindle"], float) * minutes * per_rev, 0.0)
         if kind == "bead":
             return np.where(on, self.bead_areas() * np.asarray(w["distance"], float), 0.0)
         return np.where(on, np.nan, 0.0)
@@ -79,7 +106,7 @@ class AdditiveOperation(Operation):
         [16.0, 16.0]
         """
         w = self.waypoints
-        rows = np.asarray(w["command"]) if "command" in w else np.arange(len(w["x"]))
+        rows = np.asarray(w["command"])
         n = len(self.table)
         calls = np.flatnonzero(np.asarray(self.table.name) == NAME_ID["set_bead"]) if n else np.zeros(0, int)
         area_of_row = np.full(n, np.nan)
@@ -107,6 +134,20 @@ class SubtractiveOperation(Operation):
     """An Operation of a machining process (mill, router, lathe)."""
 
     process_data_class = SubtractiveProcessData
+    process = "subtractive"
+
+    @property
+    def depositing(self) -> np.ndarray:
+        """A machining process lays no material: False at every waypoint."""
+        return self._kept("depositing", lambda: np.zeros(len(self.waypoints["x"]), bool))
+
+    def volumes(self) -> np.ndarray:
+        """Material each waypoint removes, mm^3, once a cutting simulation has added its
+        ``removed_volume`` column; NaN before."""
+        w = self.waypoints
+        if "removed_volume" in w:
+            return np.asarray(w["removed_volume"], float)
+        return super().volumes()
 
     def _process_fields(self, k: int, columns: dict[str, np.ndarray]) -> dict[str, Any]:
         fields = super()._process_fields(k, columns)

@@ -54,7 +54,7 @@ def operation_statistics(op: "Operation") -> dict[str, Any]:
         "tools": sorted(int(t) for t in np.unique(w["tool"][moving])) if moving.any() else [],
         "bounds": op.get_bounds(),
     }
-    if op.machine is not None and op.machine.process == "additive":
+    if op.process == "additive":
         if screw_extruder(op):  # pellets: no filament
             stats["filament_mm"] = stats["filament_convention"] = stats["filament_pushed_mm"] = None
         else:

@@ -23,7 +23,7 @@ from ..read import Blocks
 from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
-from .profiles import lathe_profiles
+from .lathe_profiles import lathe_profiles
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
 from .word_checks import MODAL_USERS, WORD_USERS, stray_letters, stray_word_message, user_code_keys
 from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CCW, MOTION_CUBIC, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,

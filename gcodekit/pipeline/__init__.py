@@ -133,7 +133,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         diagnostics.extend(op.diagnostics)  # its warnings
         op.diagnostics = diagnostics
     if plan and config.planner:
-        run_planner(op, config.planner, planner_settings(config.planner, config.planner_settings, machine_config))
+        op.attach_plan(run_planner(op, config.planner,
+                                   planner_settings(config.planner, config.planner_settings, machine_config)))
     restore_line_numbers(op.table, diagnostics)
     quote_diagnostics(op.diagnostics, program)
     return op

@@ -32,10 +32,9 @@ def concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarra
     """Join per-chunk waypoint columns, one column at a time to bound memory."""
     if len(parts) == 1:
         return parts[0]
-    if any("command" in p for p in parts):
-        shift = np.cumsum([0] + sizes[:-1])
-        for p, s, n in zip(parts, shift, sizes):
-            p["command"] = p.get("command", np.arange(n)) + s
+    shift = np.cumsum([0] + sizes[:-1])
+    for p, s in zip(parts, shift):  # each chunk counts its commands from 0
+        p["command"] = p["command"] + s
     out = {}
     for key in list(parts[0]):
         cols = [p.pop(key) for p in parts]

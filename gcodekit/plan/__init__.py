@@ -4,7 +4,8 @@ A machine preset names its planner (``planner = "klipper"``); each planner
 module has a settings class built from the preset's ``[planner]`` table or
 from the firmware's own configuration file, and a ``plan(op, settings)``
 function returning the firmware's moves and their planned velocities.
-:func:`apply_plan` sums the moves back onto the operation's waypoints.
+:func:`run_planner` sums them into each waypoint's time and returns a
+:class:`Plan`, which the pipeline attaches to the Operation.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from ..errors import ConfigError, did_you_mean
 from .moves import PlannedMoves, PlannerMoves, PlanResult
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 #: Planner name -> (module, settings class, reader of the firmware's own config file)
 PLANNERS = {
@@ -58,35 +59,46 @@ def planner_settings(name: str, preset: Mapping[str, Any], config_file: str | os
     return settings
 
 
-def run_planner(op: "Operation", name: str, settings) -> "Operation":
-    """Plan ``op`` with planner ``name`` and write the planned times into it."""
+@dataclasses.dataclass(frozen=True)
+class Plan:
+    """What a planner gives back: the planned time of every waypoint and the per-move plan.
+
+    The pipeline attaches it to the Operation (``Operation.attach_plan``):
+    ``time`` replaces the waypoints' ``time`` column and ``moves``/``result``
+    stay as ``op.plan``, from which :func:`waypoint_speeds` reads each
+    waypoint's entry, cruise and exit speed.
+    """
+
+    time: np.ndarray
+    moves: PlannedMoves
+    result: PlanResult
+
+
+def run_planner(program: "EmulatedProgram", name: str, settings) -> Plan:
+    """Plan an emulated program with planner ``name``; the program is not changed."""
     module = importlib.import_module(PLANNERS[name][0])
-    moves, result = module.plan(op, settings)
-    apply_plan(op, moves, result)
-    return op
+    moves, result = module.plan(program, settings)
+    return Plan(waypoint_times(program.waypoints, moves, result),
+                moves.planned() if isinstance(moves, PlannerMoves) else moves, result)
 
 
-def apply_plan(op: "Operation", moves: PlannerMoves | PlannedMoves, result: PlanResult) -> None:
+def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMoves, result: PlanResult) -> np.ndarray:
     """Per-waypoint planned time from per-move results.
 
-    A waypoint's ``time`` becomes the sum of its moves' durations (dwells
-    keep theirs); the per-move plan stays in ``op.plan`` and
-    :func:`waypoint_speeds` gives each waypoint's entry, cruise and exit speed.
+    A waypoint's time is the sum of its moves' durations; a waypoint that
+    moves without a planned move (a move to where the tool already is) takes
+    none, and one that does not move (a dwell) keeps its own.
     """
-    w = op.waypoints
     n = w["x"].size
     planned = np.bincount(moves.waypoint, weights=result.duration_t, minlength=n)
     has_moves = np.bincount(moves.waypoint, minlength=n) > 0
-    w["time"] = np.where(has_moves, planned, np.where(w["motion"] > 0, 0.0, w["time"]))
-    op.plan = (moves.planned() if isinstance(moves, PlannerMoves) else moves, result)
-    op._elapsed = None
+    return np.where(has_moves, planned, np.where(w["motion"] > 0, 0.0, w["time"]))
 
 
-def waypoint_speeds(op: "Operation") -> dict[str, np.ndarray]:
+def waypoint_speeds(plan: tuple[PlannedMoves, PlanResult], n: int) -> dict[str, np.ndarray]:
     """Planned ``start_v`` (first move's entry), ``cruise_v`` (fastest cruise),
-    ``end_v`` (last move's exit) and ``accel`` of every waypoint, mm/s and mm/s^2."""
-    moves, result = op.plan
-    n = op.waypoints["x"].size
+    ``end_v`` (last move's exit) and ``accel`` of each of ``n`` waypoints, mm/s and mm/s^2."""
+    moves, result = plan
     out = {k: np.zeros(n) for k in ("start_v", "cruise_v", "end_v", "accel")}
     if len(moves):
         first = np.r_[True, moves.waypoint[1:] != moves.waypoint[:-1]]

@@ -33,7 +33,7 @@ from .lookahead import empty_result, limit_by_axis_maximum, lookahead, trapezoid
 from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 MINIMUM_FEED_RATE = 1.0 / 60.0  # grbl config.h: MINIMUM_FEED_RATE 1.0 mm/min
 MINIMUM_JUNCTION_SPEED = 0.0  # grbl config.h, mm/s
@@ -143,7 +143,7 @@ REST_NAMES = (
 SPINDLE_NAMES = ("spindle_cw", "spindle_ccw", "spindle_off")
 
 
-def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]:
     """Plan an emulated operation as GRBL 1.1 would; one result per firmware move.
 
     Examples
@@ -199,7 +199,7 @@ def plan(op: "Operation", config: GrblConfig) -> tuple[PlannerMoves, PlanResult]
     return moves, trapezoid(move_d, acceleration, entry_v2, nominal**2, exit_v2)
 
 
-def _spindle_syncs(op: "Operation", moves: PlannerMoves, config: GrblConfig) -> np.ndarray:
+def _spindle_syncs(op: "EmulatedProgram", moves: PlannerMoves, config: GrblConfig) -> np.ndarray:
     """Per move: did a spindle change (M3/M4/M5, or a new S while on) stop the machine before it?
 
     grbl 1.1 ``gc_execute_line`` calls ``spindle_sync`` (a buffer sync) for

@@ -27,7 +27,7 @@ from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmwar
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 EXTRUDE_ONLY_ACCEL = 99999999.9  # klippy: "self.accel = 99999999.9" for extrude-only moves
 NO_LIMIT_V2 = 999999999.9  # klippy's next_junction_v2 default
@@ -144,7 +144,7 @@ def _named_args(text: str) -> dict[str, float]:
     return out
 
 
-def _velocity_limits(op: "Operation", config: KlipperConfig):
+def _velocity_limits(op: "EmulatedProgram", config: KlipperConfig):
     """Rows where the toolhead limits change, and the limits after each.
 
     M204 rows are read as columns (a sliced print has one per feature);
@@ -195,7 +195,7 @@ def _velocity_limits(op: "Operation", config: KlipperConfig):
 BLOCK = 1 << 14
 
 
-def plan(op: "Operation", config: KlipperConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult]:
     """Plan an emulated operation as Klipper would; one result per firmware move."""
     factor = speed_factor(op)
     # gcode_arcs.py: chords of at most `resolution` mm

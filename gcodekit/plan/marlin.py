@@ -43,7 +43,7 @@ from .moves import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmwa
                     m204_in_force, settings_in_force, speed_factor)
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 COS_REVERSAL = 0.999999  # planner.cpp: a junction_cos_theta above this is a full reversal
 COS_OCTAGON = -0.7071067812  # JD_HANDLE_SMALL_SEGMENTS: junctions sharper than 135 degrees
@@ -197,7 +197,7 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray,
     return np.maximum(np.maximum(by_length, by_angle), 1.0)
 
 
-def _program_limits(op: "Operation", moves: PlannerMoves, config: MarlinConfig) -> dict:
+def _program_limits(op: "EmulatedProgram", moves: PlannerMoves, config: MarlinConfig) -> dict:
     """Per move, the limits in force: the config's, then M201/M203/M204/M205 in the program.
 
     Per-axis limits are lists of four (X, Y, Z, E), each a number or an array.
@@ -224,7 +224,7 @@ def _program_limits(op: "Operation", moves: PlannerMoves, config: MarlinConfig) 
     return limits
 
 
-def plan(op: "Operation", config: MarlinConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult]:
     """Plan an emulated operation as Marlin 2 would; one result per firmware move.
 
     Examples

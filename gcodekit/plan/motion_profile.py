@@ -33,7 +33,7 @@ from .profile import BAAMMotionProfile, MotionProfile
 from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 #: Commands before which the machine has come to rest.
 STOP_NAMES = (
@@ -108,7 +108,7 @@ class MotionProfileConfig:
         return profile
 
 
-def plan(op: "Operation", config: MotionProfileConfig) -> tuple[PlannerMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: MotionProfileConfig) -> tuple[PlannerMoves, PlanResult]:
     """Plan an emulated operation with a :class:`MotionProfile`; one result per move."""
     w = op.waypoints
     n_wp = w["x"].size
@@ -168,7 +168,7 @@ def _with_kept_steps(w, moves: PlannerMoves, result: PlanResult, kept: np.ndarra
     """Insert the steps the planner has no move for, in program order, at the emulator's time."""
     k = kept.size
     position = np.column_stack([w["x"], w["y"], w["z"], np.cumsum(w["de"])])[kept]
-    rows = w["command"][kept] if "command" in w else kept
+    rows = w["command"][kept]
     extra = PlannerMoves(position, position.copy(), np.asarray(w["feed"], float)[kept] / 60.0, rows, kept)
     zero = np.zeros(k)
     extra_result = PlanResult(zero, zero, zero, np.full(k, np.inf), zero, np.asarray(w["time"], float)[kept], zero)

@@ -22,7 +22,7 @@ from ..emulate import arcs
 from ..parse.table import NAME_ID
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 #: Chords of each arc, from its length (mm), swept angle (rad), radius (mm)
 #: and requested speed (mm/s): how many segments.
@@ -109,7 +109,7 @@ class PlanResult:
         return self.accel_t + self.cruise_t + self.decel_t
 
 
-def command_rows(op: "Operation", *, names: tuple[str, ...] = (), codes: tuple[str, ...] = ()) -> np.ndarray:
+def command_rows(op: "EmulatedProgram", *, names: tuple[str, ...] = (), codes: tuple[str, ...] = ()) -> np.ndarray:
     """Rows of the commands with these normalized names or literal codes (``"M204"``, named commands)."""
     t = op.table
     mask = np.zeros(len(t), bool)
@@ -127,14 +127,14 @@ def command_rows(op: "Operation", *, names: tuple[str, ...] = (), codes: tuple[s
     return np.flatnonzero(mask)
 
 
-def speed_factor(op: "Operation") -> np.ndarray | None:
+def speed_factor(op: "EmulatedProgram") -> np.ndarray | None:
     """M220 S, as a ratio, in force at each waypoint (1 before any); None without M220."""
     t = op.table
     rows = command_rows(op, names=("set_speed_factor",))
     if rows.size == 0:
         return None
     w = op.waypoints
-    cmd = w["command"] if "command" in w else np.arange(len(w["x"]))
+    cmd = w["command"]
     values = t.param("S")[rows] / 100.0
     values = np.where(np.isnan(values), 1.0, values)
     k = np.searchsorted(rows, cmd, side="right") - 1
@@ -149,7 +149,7 @@ def in_force(moves: PlannerMoves, rows: np.ndarray, values: np.ndarray, initial:
     return np.where(k >= 0, np.asarray(values, float)[np.maximum(k, 0)], initial)
 
 
-def m204_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray,
+def m204_in_force(op: "EmulatedProgram", moves: PlannerMoves, rows: np.ndarray,
                   targets: dict[str, tuple[str, float]]) -> dict[str, np.ndarray]:
     """M204 per move: S sets every acceleration, a named word (P, T) overrides it.
 
@@ -167,7 +167,7 @@ def m204_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray,
     return out
 
 
-def settings_in_force(op: "Operation", moves: PlannerMoves, rows: np.ndarray, letter: str,
+def settings_in_force(op: "EmulatedProgram", moves: PlannerMoves, rows: np.ndarray, letter: str,
                       initial: float, scale: float | np.ndarray = 1.0) -> np.ndarray | float:
     """Per move, the last value of word ``letter`` among ``rows`` before it (``initial`` before any).
 
@@ -193,13 +193,13 @@ def happens_before(moves: PlannerMoves, rows: np.ndarray) -> np.ndarray:
     return (count_before > 0) & ~same_row
 
 
-def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
+def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None,
                    arc_segments: ArcRule | None = None) -> PlannerMoves:
     """The straight moves of an emulated operation, arcs cut by ``arc_segments``.
 
     Parameters
     ----------
-    op : Operation
+    op : EmulatedProgram
         Emulated (``op.waypoints`` present).
     speed_factor : ndarray, optional
         Per waypoint multiplier of the feed (M220), 1 when None.
@@ -212,7 +212,7 @@ def firmware_moves(op: "Operation", speed_factor: np.ndarray | None = None,
     n = w["x"].size
     e = np.cumsum(w["de"])
     columns = (w["x"], w["y"], w["z"], e)
-    rows = w["command"] if "command" in w else np.arange(n)
+    rows = w["command"]
     # Homing moves go to an endstop from wherever the axis really is: their
     # length and time are unknown, and firmware time estimates leave them out.
     homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])

@@ -39,7 +39,7 @@ from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, happ
 
 
 if TYPE_CHECKING:
-    from ..model.operation import Operation
+    from ..emulate.program import EmulatedProgram
 
 AXES = "XYZE"
 #: Commands RRF runs only once the moves before them are done (LockMovementAndWaitForStandstill).
@@ -176,7 +176,7 @@ def arc_segments(travel_d: np.ndarray, angle: np.ndarray, radius: np.ndarray, sp
     return np.maximum(np.floor(radius * np.abs(angle) / length + 0.8), 1.0)
 
 
-def _program_limits(op: "Operation", moves: PlannerMoves, config: RrfConfig) -> dict:
+def _program_limits(op: "EmulatedProgram", moves: PlannerMoves, config: RrfConfig) -> dict:
     """Per move, the limits in force, in mm/s and mm/s^2: the config's, then the program's."""
     m201 = command_rows(op, names=("set_max_accel",))
     m203 = command_rows(op, names=("set_max_feed",))
@@ -205,7 +205,7 @@ def _program_limits(op: "Operation", moves: PlannerMoves, config: RrfConfig) -> 
     return limits
 
 
-def plan(op: "Operation", config: RrfConfig) -> tuple[PlannerMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: RrfConfig) -> tuple[PlannerMoves, PlanResult]:
     """Plan an emulated operation as RepRapFirmware 3 would; one result per firmware move.
 
     Examples

@@ -14,12 +14,12 @@ from __future__ import annotations
 import dataclasses
 from typing import Iterable, Iterator
 
-from gcodekit.errors import Diagnostics, GcodeError
-from gcodekit.preprocess.expressions import evaluate as _evaluate
-from gcodekit.preprocess.expressions import parse
-from gcodekit.preprocess.flow import ControlFlowStage
-from gcodekit.preprocess.lines import SourceLine, Stage
-from gcodekit.preprocess.parameters import ParameterStage, ParameterStore, needs_parameters
+from ..errors import Diagnostics, GcodeError
+from .expressions import evaluate as _evaluate
+from .expressions import parse
+from .flow import ControlFlowStage
+from .lines import SourceLine, Stage
+from .parameters import ParameterStage, ParameterStore, needs_parameters
 
 
 def run_stages(

@@ -36,7 +36,7 @@ import re
 from dataclasses import dataclass
 from typing import Protocol, Union
 
-from gcodekit.errors import (
+from ..errors import (
     Diagnostic,
     GcodeError,
     GcodeExpressionError,

@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Iterable, Iterator, Protocol, runtime_checkable
 
-from gcodekit.errors import Diagnostics
-from gcodekit.lathe_profile import LatheProfile
+from ..errors import Diagnostics
+from ..lathe_profile import LatheProfile
 
 
 @dataclass(frozen=True, slots=True)

@@ -16,8 +16,8 @@ import re
 from decimal import Decimal
 from typing import TYPE_CHECKING, Callable, Iterable, Iterator, Protocol, Sequence
 
-from gcodekit.errors import Diagnostics, GcodeError, GcodeExpressionError, GcodeLimitError
-from gcodekit.preprocess.expressions import (
+from ..errors import Diagnostics, GcodeError, GcodeExpressionError, GcodeLimitError
+from .expressions import (
     CompactText,
     NamedParameter,
     Node,
@@ -30,8 +30,8 @@ from gcodekit.preprocess.expressions import (
 )
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess.lines import SourceLine
-    from gcodekit.syntax.flavor import Flavor
+    from .lines import SourceLine
+    from ..syntax.flavor import Flavor
 
 #: Highest parameter number.  LinuxCNC's ``RS274NGC_MAX_PARAMETERS`` is 5602
 #: and it accepts numbers below it, 1 .. 5601.

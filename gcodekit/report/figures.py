@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..view import WORK, Coloring, Toolpath, ToolpathError, coloring, default_coloring, is_additive
+from ..view import WORK, Coloring, Toolpath, ToolpathError, coloring, default_coloring
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -75,7 +75,7 @@ def toolpath_drawing(op: "Operation", color_by: str | None = None) -> Drawing | 
     except ToolpathError:
         return None
     color = coloring(path, color_by or default_coloring(op))
-    keep = path.kind == WORK if is_additive(op) else np.ones(path.n_segments, bool)
+    keep = path.kind == WORK if op.process == "additive" else np.ones(path.n_segments, bool)
     return Drawing(path, color, np.flatnonzero(keep))
 
 

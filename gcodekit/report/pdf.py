@@ -25,13 +25,15 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from ..errors import MissingDependencyError
+
 #: Executable names of Chromium on Debian, other Linux distributions and macOS installs.
 CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 #: Seconds Chromium may take to answer one request; a report page prints in about one.
 TIMEOUT_S = 120
 
 
-class ChromiumNotFound(RuntimeError):
+class ChromiumNotFound(MissingDependencyError):
     """No Chromium to print PDFs with."""
 
 

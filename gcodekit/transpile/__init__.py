@@ -101,7 +101,7 @@ class Transpiler:
         # moves under a G10 L2 R rotation are written from their waypoints from stage 2
         self._rotated_rows = np.zeros(len(self.op.table), bool)
         turned = np.asarray(w["rotation"]) != 0
-        np.logical_or.at(self._rotated_rows, w["command"] if "command" in w else np.arange(turned.size), turned)
+        np.logical_or.at(self._rotated_rows, w["command"], turned)
         self._incremental_rows = mode_rows(self.op.table, "distance_incremental", "distance_absolute")  # G91
         self._rotary_axes = [a for a in "ABC" if np.any(np.asarray(w[a.lower()]) != 0)]  # written when used
         self._arc_absolute_rows = mode_rows(self.op.table, "arc_distance_absolute", "arc_distance_incremental")

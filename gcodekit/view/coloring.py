@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import check_choice
-from .toolpath import WORK, Toolpath, is_additive
+from .toolpath import WORK, Toolpath
 
 if TYPE_CHECKING:
     from matplotlib.colors import ListedColormap
@@ -81,7 +81,7 @@ def default_coloring(op: "Operation") -> str:
     """``feature`` when the program names its features, else ``layer`` (additive) or ``feed``."""
     if has_features(op):
         return "feature"
-    return "layer" if is_additive(op) else "feed"
+    return "layer" if op.process == "additive" else "feed"
 
 
 def choices(path: Toolpath) -> list[str]:
@@ -92,7 +92,7 @@ def choices(path: Toolpath) -> list[str]:
     if path.group_by == "layer":
         named.append("layer")
     named += ["time", "tool"]
-    if hasattr(op, "deposited_volumes"):
+    if op.process == "additive":
         named.append("flow")
     rows = path.move_rows
     # a column that never changes over the moves would paint everything one colour

@@ -45,31 +45,14 @@ class ToolpathError(NothingToShowError):
     """A program the pictures cannot draw (not emulated, no motions)."""
 
 
-def is_additive(op: "Operation") -> bool:
-    """Whether ``op`` lays material (its machine's process is additive)."""
-    return op.machine is not None and op.machine.process == "additive"
-
-
-def moving_mask(op: "Operation") -> np.ndarray:
-    """Waypoints that end a move of non-zero length (a move runs from the waypoint before it)."""
-    w = op.waypoints
-    moving = (np.asarray(w["motion"]) > 0) & (np.asarray(w["distance"]) > 0)
-    moving[:1] = False
-    return moving
-
-
 def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
-    """Waypoints that end a work move, and those that end any other move.
+    """Waypoints that end a work move (``op.work``: what the process makes), and those that end any other move.
 
-    The work is the depositing moves from the first layer on (start-code
-    purge lines are not the part) or, for a mill, the feed moves.
+    A move runs from the waypoint before it, so the first waypoint ends none.
     """
-    moving = moving_mask(op)
-    if is_additive(op):
-        work = op.depositing & (op.layers >= 0)
-    else:
-        work = np.asarray(op.waypoints["motion"]) >= 2
-    work = work & moving
+    moving = op.moving.copy()
+    moving[:1] = False
+    work = op.work & moving
     return work, moving & ~work
 
 
@@ -135,7 +118,7 @@ class Toolpath:
         moving = work | travel
         if not moving.any():
             raise ToolpathError(f"{op.file}: nothing to draw (the program has no motions)")
-        group_by = group_by or ("layer" if is_additive(op) else "z")
+        group_by = group_by or ("layer" if op.process == "additive" else "z")
         check_choice("group_by", group_by, GROUP_BY)
         rows = np.flatnonzero(moving)
         key, labels = _group_keys(op, rows, work[rows], group_by, waypoint_layer)
@@ -207,8 +190,7 @@ class Toolpath:
 
 
 def _command_rows(op: "Operation") -> np.ndarray:
-    w = op.waypoints
-    return w["command"] if "command" in w else np.arange(len(op.table))
+    return op.waypoints["command"]
 
 
 def _group_keys(op, rows, work, group_by, waypoint_layer) -> tuple[np.ndarray, list[str]]:

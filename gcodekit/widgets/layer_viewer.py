@@ -242,8 +242,7 @@ class LayerViewer(PictureDisplay):
                 style = "background:#ffe08a;font-weight:600" if k == line else "color:#555"
                 rows.append(f'<div style="{style}"><span style="color:#999">{k:>6} </span>{text}</div>')
         else:
-            row = int(self.path.op.waypoints["command"][self.path.move_rows[self.current_move]]) \
-                if "command" in self.path.op.waypoints else int(self.path.move_rows[self.current_move])
+            row = int(self.path.op.waypoints["command"][self.path.move_rows[self.current_move]])
             rows.append(f"<div>{html.escape(str(self.path.op.table.command(row)))}</div>")
         self.code.value = (f'<div class="gcodekit-code" data-line="{line}" style="font:12px monospace;'
                            f'white-space:pre">line {line}, move {self.current_move}<br>{"".join(rows)}</div>')

@@ -278,9 +278,10 @@ class StageDiff(PictureDisplay):
                 return message_figure(f"{side.name}: cannot draw its toolpath: {friendly(exc)}")
             w = op.waypoints
             motion = np.asarray(w["motion"])
-            from ..view import move_segments, moving_mask
+            from ..view import move_segments
 
-            rows = np.flatnonzero(moving_mask(op))
+            rows = np.flatnonzero(op.moving)
+            rows = rows[rows > 0]  # a move runs from the waypoint before it
             start, end, move_of = move_segments(w, rows)
             rapid = motion[rows][move_of] == 1
             # the left stage wide and pale under the right one: where both agree, both stay visible

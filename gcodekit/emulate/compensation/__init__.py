@@ -59,22 +59,22 @@ from .geometry import CONCAVE_CORNER
 from .states import SIDES, Compensator
 
 if TYPE_CHECKING:
-    from ...model.operation import Operation
+    from ..program import EmulatedProgram
 
 __all__ = ["CONCAVE_CORNER", "compensate", "uses_compensation"]
 
 
-def uses_compensation(op: "Operation") -> bool:
+def uses_compensation(op: "EmulatedProgram") -> bool:
     """Whether the program switches compensation on (G41, G42, G41.1 or G42.1) anywhere."""
     return bool(np.isin(op.table.name, [k for k, side in SIDES.items() if side]).any())
 
 
-def compensate(op: "Operation", tools, profile_ends: list[tuple[int, np.ndarray]] = ()) -> None:
+def compensate(op: "EmulatedProgram", tools, profile_ends: list[tuple[int, np.ndarray]] = ()) -> None:
     """Rewrite ``op.waypoints`` with the compensated tool path (in place).
 
     Parameters
     ----------
-    op : Operation
+    op : EmulatedProgram
         The emulated operation; compensation errors (gouges, entry moves
         shorter than the radius, arcs smaller than the tool) are reported to
         its diagnostics, as rs274 reports them.

@@ -41,7 +41,7 @@ from .path import ToolPath
 from .queue import Queue, QueuedArc
 
 if TYPE_CHECKING:
-    from ...model.operation import Operation
+    from ..program import EmulatedProgram
 
 #: The compensation codes and the side each puts the tool on (+1 left, -1 right, 0 off).
 SIDES = {NAME_ID["cutter_comp_left"]: 1, NAME_ID["cutter_comp_right"]: -1, NAME_ID["cutter_comp_off"]: 0,
@@ -76,7 +76,7 @@ class Compensator:
 
     Parameters
     ----------
-    op : Operation
+    op : EmulatedProgram
         The emulated operation (its waypoints are replaced; errors go to its diagnostics).
     tools : dict
         The machine's tool table: number -> tool (``diameter``, ``orientation``).
@@ -84,10 +84,10 @@ class Compensator:
         (source line, machine X Y Z) of each G70 run under compensation, in order.
     """
 
-    def __init__(self, op: "Operation", tools, profile_ends):
+    def __init__(self, op: "EmulatedProgram", tools, profile_ends):
         self.op, self.table, self.tools = op, op.table, tools
         w = op.waypoints
-        self.rows = w["command"] if "command" in w else np.arange(w["x"].size)
+        self.rows = w["command"]
         self.out = ToolPath(w, self.rows)
         self.columns = self.out.columns
         self.profile_ends = list(profile_ends)

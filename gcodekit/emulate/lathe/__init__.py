@@ -8,7 +8,7 @@ radius).  The profile is the chain of G0/G1/G2/G3 blocks of the ``Q``
 subroutine (a :class:`~gcodekit.lathe_profile.LatheProfile`, read by the
 preprocess stage), starting at the cycle point (the block's X/Z).  The cycle
 mirrors and rotates the profile so that it always descends in X and Z
-(``_Profile.normalise``), works there, and maps every move back.
+(``Contour.normalise``), works there, and maps every move back.
 
 * G71 cuts passes parallel to Z, G72 (the profile turned 90 degrees)
   parallel to X; ``I`` apart, leaving ``D`` to the profile.  Each pass is

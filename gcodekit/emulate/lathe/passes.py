@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ...limits import MotionBudget
-from .profile import Profile
+from .contour import Contour
 from .segments import TOLERANCE, Arc, Chamfer, Fillet, Line, Move, Segment, Sink
 
 __all__ = ["build_profile", "finish", "rough"]
@@ -32,7 +32,7 @@ def build_profile(start: complex, blocks: list[dict]) -> list[Segment]:
 def finish(segments: list[Segment], point: complex, d: float, e: float, passes: float, *,
            budget: MotionBudget | None = None) -> list[Move]:
     """G70: ``passes`` finishing passes from distance ``d`` down to ``e``."""
-    base = Profile([s.copy() for s in segments])
+    base = Contour([s.copy() for s in segments])
     base.segments[0].start = point
     probe = base.copy()
     probe.segments.pop(0)
@@ -68,7 +68,7 @@ def rough(segments: list[Segment], point: complex, *, turn: bool, subcycle: int,
     ``budget``, when given, must have room for the most moves the passes can
     make: each pass crosses every segment at most once.
     """
-    p = Profile([s.copy() for s in segments])
+    p = Contour([s.copy() for s in segments])
     p.segments[0].start = point
     if turn:
         p.turn()

@@ -12,6 +12,8 @@ import copy
 import math
 from dataclasses import dataclass
 
+from ...errors import GcodeMachineError
+
 __all__ = ["TOLERANCE", "EQUAL", "LatheCycleError", "Move", "Sink", "Segment", "Line", "Arc", "Fillet", "Chamfer",
            "intersect"]
 
@@ -20,7 +22,7 @@ TOLERANCE = 1e-6  # LinuxCNC's g7x tolerance
 EQUAL = 0.0001
 
 
-class LatheCycleError(ValueError):
+class LatheCycleError(GcodeMachineError):
     """A profile the cycle cannot cut; the message is rs274's."""
 
 

@@ -43,7 +43,7 @@ subroutine, ...) are reported with their file, line and column; in lenient
 mode the faulty O-word is ignored and the run goes on.
 """
 
-from gcodekit.preprocess.flow.stage import MAX_CALL_DEPTH, MAX_LINES, ControlFlowStage
-from gcodekit.preprocess.flow.statements import KEYWORDS, OWord
+from .stage import MAX_CALL_DEPTH, MAX_LINES, ControlFlowStage
+from .statements import KEYWORDS, OWord
 
 __all__ = ["ControlFlowStage", "MAX_CALL_DEPTH", "MAX_LINES", "KEYWORDS", "OWord"]

@@ -12,11 +12,11 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from gcodekit.preprocess.parameters import format_number
+from ..parameters import format_number
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess.lines import SourceLine
-    from gcodekit.preprocess.flow.run import Run
+    from ..lines import SourceLine
+    from .run import Run
 
 
 def m98(run: Run, line: SourceLine, p: float | None, count: float) -> None:

@@ -14,10 +14,10 @@ import re
 from pathlib import Path
 from typing import Callable
 
-from gcodekit.errors import did_you_mean
-from gcodekit.preprocess.flow.linking import Table, link
-from gcodekit.preprocess.flow.statements import Code, OWord, Report, where
-from gcodekit.preprocess.lines import SourceLine
+from ...errors import did_you_mean
+from .linking import Table, link
+from .statements import Code, OWord, Report, where
+from ..lines import SourceLine
 
 # LinuxCNC subroutine file names: lower-case letters, digits, '-' and '_'.
 _FILE_NAME = re.compile(r"[a-z0-9_-]+")

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from gcodekit.preprocess.flow.statements import Code, OWord, Report
+from .statements import Code, OWord, Report
 
 #: What closes each opening O-word, and what each closing one closes
 _CLOSER = {"sub": "endsub", "if": "endif", "while": "endwhile", "do": "while", "repeat": "endrepeat"}

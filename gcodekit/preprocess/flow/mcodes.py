@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from typing import Callable, NamedTuple
 
-from gcodekit.preprocess.expressions import compact
+from ..expressions import compact
 
 #: A letter and the number after it, in compacted (lower-case, blank-free) text
 WORD = re.compile(r"([a-z])([-+]?[0-9.]*)")

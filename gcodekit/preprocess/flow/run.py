@@ -17,18 +17,18 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
 
-from gcodekit.errors import Diagnostics, GcodeError, GcodeLimitError
-from gcodekit.preprocess.expressions import Node, evaluate
-from gcodekit.preprocess.flow.fanuc import m98, m99
-from gcodekit.preprocess.flow.library import Library
-from gcodekit.preprocess.flow.mcodes import flow_m, remove
-from gcodekit.preprocess.flow.profile import with_profile
-from gcodekit.preprocess.flow.statements import Code, OWord, read_statement, where
-from gcodekit.preprocess.parameters import format_number
+from ...errors import Diagnostics, GcodeError, GcodeLimitError
+from ..expressions import Node, evaluate
+from .fanuc import m98, m99
+from .library import Library
+from .mcodes import flow_m, remove
+from .lathe_profile_capture import with_profile
+from .statements import Code, OWord, read_statement, where
+from ..parameters import format_number
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess.lines import SourceLine
-    from gcodekit.preprocess.flow.stage import ControlFlowStage
+    from ..lines import SourceLine
+    from .stage import ControlFlowStage
 
 
 @dataclass(slots=True)

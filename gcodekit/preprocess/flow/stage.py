@@ -6,14 +6,14 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterable, Iterator, Sequence
 
-from gcodekit.errors import Diagnostics
-from gcodekit.limits import MAX_ITERATIONS, MAX_MOTIONS
-from gcodekit.preprocess.flow.run import Run
-from gcodekit.preprocess.parameters import ParameterStage, ParameterStore
+from ...errors import Diagnostics
+from ...limits import MAX_ITERATIONS, MAX_MOTIONS
+from .run import Run
+from ..parameters import ParameterStage, ParameterStore
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess.lines import SourceLine
-    from gcodekit.syntax.flavor import Flavor
+    from ..lines import SourceLine
+    from ...syntax.flavor import Flavor
 
 #: Deepest nesting of subroutine calls.  LinuxCNC has
 #: ``INTERP_SUB_ROUTINE_LEVELS`` = 10 call frames, frame 0 being the main

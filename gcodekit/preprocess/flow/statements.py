@@ -12,11 +12,11 @@ import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
-from gcodekit.errors import GcodeError, GcodeLimitError, did_you_mean
-from gcodekit.preprocess.expressions import CompactText, Node, compact, expression_error, parse_value
+from ...errors import GcodeError, GcodeLimitError, did_you_mean
+from ..expressions import CompactText, Node, compact, expression_error, parse_value
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess.lines import SourceLine
+    from ..lines import SourceLine
 
 # Longest first, so 'elseif' is not read as 'else'.
 KEYWORDS = ("endrepeat", "continue", "endwhile", "elseif", "endsub", "repeat", "return",

@@ -54,9 +54,9 @@ reported at the call's ``file:line:col``; a wizard that raises becomes a
 diagnostic with its message (lenient) or a :class:`WizardError` (strict).
 """
 
-from gcodekit.preprocess.wizards.builtins import bolt_circle, circle_pocket, drill_grid, face, pocket
-from gcodekit.preprocess.wizards.context import DEFAULT_SETTINGS, MAX_LINES, WizardArgumentError, WizardContext
-from gcodekit.preprocess.wizards.registry import (
+from .builtins import bolt_circle, circle_pocket, drill_grid, face, pocket
+from .context import DEFAULT_SETTINGS, MAX_LINES, WizardArgumentError, WizardContext
+from .registry import (
     DEFAULT_REGISTRY,
     WizardRegistry,
     WizardWarning,
@@ -65,7 +65,7 @@ from gcodekit.preprocess.wizards.registry import (
     wizard,
     wizards,
 )
-from gcodekit.preprocess.wizards.stage import WizardError, WizardStage, needs_wizards
+from .stage import WizardError, WizardStage, needs_wizards
 
 __all__ = [
     "WizardStage",

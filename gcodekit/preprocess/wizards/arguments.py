@@ -8,10 +8,10 @@ import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from gcodekit.preprocess.wizards.context import WizardFunction
+from .context import WizardFunction
 
 if TYPE_CHECKING:
-    from gcodekit.syntax.flavor import Flavor
+    from ...syntax.flavor import Flavor
 
 _NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)")
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import Iterator
 
-from gcodekit.preprocess.wizards.context import MAX_LINES, WizardArgumentError, WizardContext, WizardFunction
+from .context import MAX_LINES, WizardArgumentError, WizardContext, WizardFunction
 
 # Most passes, rows or rings one built-in plans; beyond that the arguments
 # are nonsense (a 1e-9 stepdown), not a program.

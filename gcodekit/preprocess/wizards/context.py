@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, Mapping
 
-from gcodekit.units import MM_PER_INCH
+from ...errors import GcodeError
+from ...units import MM_PER_INCH
 
 #: Most lines one wizard call may emit; more is taken as a runaway.
 MAX_LINES = 1_000_000
@@ -19,7 +20,7 @@ DEFAULT_SETTINGS: Mapping[str, float] = {
 }
 
 
-class WizardArgumentError(ValueError):
+class WizardArgumentError(GcodeError, ValueError):
     """Raised by a wizard function about one of its arguments.
 
     The stage reports it at that argument's column as a

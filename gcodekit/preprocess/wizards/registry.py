@@ -6,9 +6,9 @@ import re
 import warnings
 from typing import Callable
 
-from gcodekit.errors import ConfigError, did_you_mean
-from gcodekit.preprocess.wizards.builtins import BUILTINS
-from gcodekit.preprocess.wizards.context import WizardFunction
+from ...errors import ConfigError, did_you_mean
+from .builtins import BUILTINS
+from .context import WizardFunction
 
 # A wizard name: two ASCII letters, then letters, digits or '_' (GER: "wizard
 # commands must start with two consecutive letters").

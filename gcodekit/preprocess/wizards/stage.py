@@ -6,7 +6,7 @@ import contextlib
 import re
 from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping
 
-from gcodekit.errors import (
+from ...errors import (
     Diagnostic,
     Diagnostics,
     GcodeError,
@@ -15,15 +15,15 @@ from gcodekit.errors import (
     GcodeMachineError,
     did_you_mean,
 )
-from gcodekit.limits import MAX_MOTIONS
-from gcodekit.preprocess.lines import SourceLine
-from gcodekit.preprocess.wizards.arguments import Argument, BadCall, bind, read_arguments
-from gcodekit.preprocess.wizards.context import MAX_LINES, WizardArgumentError, WizardContext, WizardFunction
-from gcodekit.preprocess.wizards.registry import DEFAULT_REGISTRY, NAME, WizardRegistry
-from gcodekit.units import MM_PER_INCH
+from ...limits import MAX_MOTIONS
+from ..lines import SourceLine
+from .arguments import Argument, BadCall, bind, read_arguments
+from .context import MAX_LINES, WizardArgumentError, WizardContext, WizardFunction
+from .registry import DEFAULT_REGISTRY, NAME, WizardRegistry
+from ...units import MM_PER_INCH
 
 if TYPE_CHECKING:
-    from gcodekit.syntax.flavor import Flavor
+    from ...syntax.flavor import Flavor
 
 _LOOKS_LIKE_CALL = re.compile(r"(?m)^[ \t]*[A-Za-z]{2}")
 _UNITS = re.compile(r"(?<![A-Za-z])[gG][ \t]*0*(2[01]|9[01])(?![0-9.])")

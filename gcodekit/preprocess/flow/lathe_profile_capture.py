@@ -15,15 +15,15 @@ import re
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from gcodekit.lathe_profile import LatheProfile, ProfileBlock
-from gcodekit.preprocess.expressions import compact
-from gcodekit.preprocess.flow.mcodes import WORD
-from gcodekit.preprocess.flow.statements import OWord
-from gcodekit.preprocess.parameters import format_number
+from ...lathe_profile import LatheProfile, ProfileBlock
+from ..expressions import compact
+from .mcodes import WORD
+from .statements import OWord
+from ..parameters import format_number
 
 if TYPE_CHECKING:
-    from gcodekit.preprocess.lines import SourceLine
-    from gcodekit.preprocess.flow.run import Run
+    from ..lines import SourceLine
+    from .run import Run
 
 # Cheap test for a line that may hold a lathe cycle G70-G72
 _MAYBE_LATHE_CYCLE = re.compile(r"[gG][ \t0]*7[ \t]*[012]")

@@ -1,8 +1,10 @@
-"""Emulate stage, lathe cycles: the profile as a chain of segments, normalised, offset and pocketed.
+"""Emulate stage, lathe cycles: the profile's contour, a chain of segments normalised, offset and pocketed.
 
-:class:`Profile` is LinuxCNC's ``g7x`` class: it mirrors and rotates the
-chain so it always descends in X and Z, offsets it step by step, and cuts the
-roughing passes pocket by pocket.
+The contour is the lathe profile as geometry (:mod:`gcodekit.lathe_profile`
+holds the same profile as the blocks the program wrote).  :class:`Contour`
+is LinuxCNC's ``g7x`` class: it mirrors and rotates the chain so it always
+descends in X and Z, offsets it step by step, and cuts the roughing passes
+pocket by pocket.
 """
 
 from __future__ import annotations
@@ -11,11 +13,11 @@ from dataclasses import dataclass, field
 
 from .segments import TOLERANCE, Arc, LatheCycleError, Segment, Sink, intersect
 
-__all__ = ["Profile"]
+__all__ = ["Contour"]
 
 
 @dataclass
-class Profile:
+class Contour:
     """The segments of a profile and the mirror/rotation state it is in."""
 
     segments: list[Segment] = field(default_factory=list)
@@ -24,8 +26,8 @@ class Profile:
     escape: complex = 0.3 + 0.3j
     pocket_starts: list[complex] = field(default_factory=list)
 
-    def copy(self) -> "Profile":
-        return Profile([s.copy() for s in self.segments], self.state, self.delta, self.escape, [])
+    def copy(self) -> "Contour":
+        return Contour([s.copy() for s in self.segments], self.state, self.delta, self.escape, [])
 
     def turn(self) -> None:
         for s in self.segments:
