@@ -25,7 +25,7 @@ from .model.derived import depositing, depositing_of, features, layers, row_labe
 from .model.statistics import operation_statistics
 from .parse.table import NAME_ID as NAME_ID_LOOKUP
 
-__all__ = ["time_by", "velocity_profile", "part_name", "tool_vectors", "ded_moves", "depositing", "depositing_of",
+__all__ = ["time_by", "slicer_layer_times", "velocity_profile", "part_name", "tool_vectors", "ded_moves", "depositing", "depositing_of",
            "features", "layers", "screw_extruder", "waypoint_rows", "operation_statistics", "event_series",
            "gcode_dataframe_to_event_series"]
 
@@ -63,6 +63,53 @@ def time_by(op: "Operation", key: str = "layer") -> "pd.DataFrame":
         "filament_mm": np.asarray(w["de"], float),
     })
     return frame.groupby(key, sort=(key != "feature")).sum()
+
+
+def slicer_layer_times(op: "Operation", mode: str = "normal") -> "pd.DataFrame":
+    """Time by layer, gcodekit's planned time beside the slicer's own progress marks.
+
+    A layer is compared at the last mark the slicer wrote inside it (Cura's
+    ``;TIME_ELAPSED:`` closes every layer; PrusaSlicer's M73 falls where its
+    percentage or whole minutes left change, so its elapsed time is exact
+    only to the minute).  Layers without a mark are left out.
+
+    Parameters
+    ----------
+    mode : {"normal", "silent"}, default: "normal"
+        Which of PrusaSlicer's two series of marks (M73 P/R or Q/S).
+
+    Returns
+    -------
+    DataFrame indexed by ``layer`` with ``line`` (the mark's), ``elapsed_s``
+    (gcodekit's planned time from the start to the mark), ``slicer_elapsed_s``,
+    ``layers`` (how many layers since the previous compared layer), ``time_s``
+    and ``slicer_time_s`` (over those layers) and ``difference_s``
+    (``elapsed_s - slicer_elapsed_s``).  Empty when the file has no marks.
+    """
+    import pandas as pd
+
+    from .errors import check_choice
+
+    check_choice("mode", mode, ("normal", "silent"))
+    marks = [m for m in op.slicer_figures().marks if m.mode == mode]
+    columns = ["line", "elapsed_s", "slicer_elapsed_s", "layers", "time_s", "slicer_time_s", "difference_s"]
+    rows_of = waypoint_rows(op)
+    elapsed, layer = op.elapsed_time(), op.layers
+    by_layer: dict[int, tuple[int, float, float]] = {}
+    for m in marks:
+        before = int(np.searchsorted(rows_of, m.row, side="left")) - 1  # the last waypoint before the mark
+        if before < 0 or layer[before] < 0:
+            continue
+        by_layer[int(layer[before])] = (m.line, float(elapsed[before]), m.elapsed_s)
+    if not by_layer:
+        return pd.DataFrame(columns=columns, index=pd.Index([], name="layer"))
+    frame = pd.DataFrame.from_dict(by_layer, orient="index", columns=columns[:3]).sort_index()
+    frame.index.name = "layer"
+    frame["layers"] = np.diff(frame.index.to_numpy(), prepend=-1)
+    frame["time_s"] = frame["elapsed_s"].diff().fillna(frame["elapsed_s"])
+    frame["slicer_time_s"] = frame["slicer_elapsed_s"].diff().fillna(frame["slicer_elapsed_s"])
+    frame["difference_s"] = frame["elapsed_s"] - frame["slicer_elapsed_s"]
+    return frame
 
 
 def velocity_profile(op: "Operation") -> "pd.DataFrame":

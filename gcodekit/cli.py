@@ -118,6 +118,7 @@ def _parser() -> argparse.ArgumentParser:
     notebook.add_argument("--html", action="store_true",
                           help="also write NAME.html that shows its pictures offline (runs it)")
     notebook.add_argument("-f", "--force", action="store_true", help="overwrite NAME.ipynb if it exists")
+    _limits(notebook)
     return p
 
 
@@ -250,6 +251,8 @@ def _text(r: dict[str, Any]) -> str:
     if r["layers"] is not None:
         filament = f"   filament {r['filament_mm']:.1f} mm" if r["filament_mm"] is not None else ""
         lines.append(f"  layers     {r['layers']}{filament}")
+    if r.get("slicer"):
+        lines.append(_slicer_line(r))
     if r["tools"]:
         lines.append(f"  tools      {' '.join(map(str, r['tools']))}")
     diags = r["diagnostics"]
@@ -261,6 +264,19 @@ def _text(r: dict[str, Any]) -> str:
     if len(diags) > 20:
         lines.append(f"    ... {len(diags) - 20} more (see --json)")
     return "\n".join(lines) + "\n"
+
+
+def _slicer_line(r: dict[str, Any]) -> str:
+    """What the slicer says beside gcodekit's figures, with the difference."""
+    from .model.slicer import compare
+
+    theirs = r["slicer"]
+    name = " ".join(v for v in (theirs["slicer"], theirs["version"]) if v) or "slicer"
+    shown = {"time": lambda v: _duration(v), "filament": lambda v: f"{v:.1f} mm", "layers": str}
+    parts = [f"{row['figure']} {shown[row['figure']](row['slicer'])}"
+             + (f" (gcodekit {100 * row['difference']:+.1f} %)" if row["difference"] else " (gcodekit the same)")
+             for row in compare(r)]
+    return f"  slicer     {name} says: " + ("  ".join(parts) or "no figures")
 
 
 def _duration(seconds: float) -> str:
@@ -279,9 +295,12 @@ def _exists(path: str | None, args: argparse.Namespace) -> bool:
     return False
 
 
-def _report_errors(op) -> None:
+def _report_errors(op) -> int:
+    """Print the program's first errors; the exit status: 1 when a limit stopped it (the output is
+    partial), else 0."""
     for d in [d for d in op.diagnostics if d.severity == "error"][:10]:
         print(str(d), file=sys.stderr)
+    return EXIT_PROGRAM_ERROR if op.diagnostics.limit_errors else 0
 
 
 def _export(args: argparse.Namespace) -> int:
@@ -294,6 +313,7 @@ def _export(args: argparse.Namespace) -> int:
     if _exists(output, args):
         return 2
     op = _load(args.file, args)
+    status = _report_errors(op)  # first: a program a limit stopped may leave nothing to export
     target = output if output else sys.stdout
     if args.to == "csv":
         op.motions().to_csv(target, index=False, float_format="%.6f", lineterminator="\n")
@@ -318,8 +338,7 @@ def _export(args: argparse.Namespace) -> int:
             if part.depositions.empty:
                 raise NothingToShowError(f"{args.file}: no deposition moves to export")
             VTKExporter.additive_part_to_vtk(part, output)
-    _report_errors(op)
-    return 0
+    return status
 
 
 def _render(args: argparse.Namespace) -> int:
@@ -336,10 +355,10 @@ def _render(args: argparse.Namespace) -> int:
     if _exists(args.output, args):
         return 2
     op = _load(args.file, args)
+    status = _report_errors(op)  # first: a program a limit stopped may leave nothing to draw
     plot_operation(op, args.color_by, show_travel=args.travel, tool_vectors=args.tool_vectors, camera=args.view,
                    screenshot=args.output, window_size=size)
-    _report_errors(op)
-    return 0
+    return status
 
 
 def _translate(args: argparse.Namespace) -> int:
@@ -358,8 +377,7 @@ def _translate(args: argparse.Namespace) -> int:
         Path(args.output).write_text(text)
     else:
         sys.stdout.write(text)
-    _report_errors(op)
-    return 0
+    return _report_errors(op)
 
 
 def _report(args: argparse.Namespace) -> int:
@@ -408,7 +426,8 @@ def _notebook(args: argparse.Namespace) -> int:
 
         load_machine(args.machine)
     write_exploration_notebook(args.file, args.output, machine=args.machine, machine_config=args.machine_config,
-                               execute=args.execute, html=args.html)
+                               execute=args.execute, html=args.html, max_motions=args.max_motions,
+                               max_iterations=args.max_iterations)
     print(f"notebook written to {args.output}" + (" (and its .html)" if args.html else ""))
     return 0
 

@@ -169,6 +169,12 @@ class Diagnostics:
         raise _ERROR_TYPES[self._kinds[k]](self.items[k].message, self.items[k])
 
     @property
+    def limit_errors(self) -> list[Diagnostic]:
+        """The errors of a limit reached (``max_motions``, ``max_iterations``, ...): the run stopped short
+        of the program's end, or planned part of it coarser (see :mod:`gcodekit.limits`)."""
+        return [d for d, kind in zip(self.items, self._kinds) if kind == "limit" and d.severity == "error"]
+
+    @property
     def errors(self) -> list[Diagnostic]:
         return [d for d in self.items if d.severity == "error"]
 

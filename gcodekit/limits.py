@@ -36,13 +36,15 @@ from dataclasses import dataclass
 
 from .errors import ConfigError
 
-__all__ = ["MAX_MOTIONS", "MAX_ITERATIONS", "Limits", "MotionBudget", "TooManyMotions", "check_limit"]
+__all__ = ["MAX_MOTIONS", "MAX_ITERATIONS", "PLAUSIBLE_TIME_S", "Limits", "MotionBudget", "TooManyMotions", "check_limit"]
 
 #: Default ``max_motions``: above any real program (a 150 mm FFF plate makes about
 #: 3 million; the largest LFAM and DED programs tens of millions).
 MAX_MOTIONS = 50_000_000
 #: Default ``max_iterations``: an endless loop that moves nothing stops within seconds.
 MAX_ITERATIONS = 100_000
+#: A program planned to run longer than this (a year, in seconds) gets a warning: no machine runs it.
+PLAUSIBLE_TIME_S = 365.25 * 86400.0
 
 
 @dataclass(frozen=True)

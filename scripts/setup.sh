@@ -2,7 +2,7 @@
 # Create .venv and install gcodekit with its test and report tools, once per
 # change of pyproject.toml; install Chromium (PDF reports) and poppler-utils
 # (the PDF test) with apt-get when missing, and for the tests LinuxCNC's rs274
-# (the differential check against it).  Sourced by run-examples.sh and
+# (the differential check against it) and Cura's printer definitions.  Sourced by run-examples.sh and
 # run-tests.sh (which sets GCODEKIT_SETUP_RS274=1).
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -53,6 +53,16 @@ if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -x /usr/bin/rs274 ]; then
     apt_install "LinuxCNC's rs274, the reference of the differential tests" --no-install-recommends linuxcnc-uspace
   else
     die "the differential tests need LinuxCNC's rs274: install it as root (apt-get install --no-install-recommends linuxcnc-uspace), then run this again"
+  fi
+fi
+
+# Cura's printer definitions (Debian package cura) are the reference the Creality Ender-3 preset is
+# checked against (tests/test_slicer_figures.py); only the test command asks for them.
+if [ "${GCODEKIT_SETUP_RS274:-0}" = 1 ] && [ ! -f /usr/share/cura/resources/definitions/creality_base.def.json ]; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    apt_install "Cura's printer definitions, the reference of the Ender-3 preset" --no-install-recommends cura
+  else
+    die "the slicer tests need Cura's printer definitions: install them as root (apt-get install --no-install-recommends cura), then run this again"
   fi
 fi
 

@@ -31,7 +31,7 @@ STAGES: list[tuple[str, ...]] = [
     ("gcodekit.analysis", "gcodekit.additive", "gcodekit.export", "gcodekit.view", "gcodekit.visualize",
      "gcodekit.transpile"),
     ("gcodekit.pipeline",),
-    ("gcodekit.report", "gcodekit.widgets", "gcodekit.cli", "gcodekit.testing", "gcodekit"),
+    ("gcodekit.report", "gcodekit.widgets", "gcodekit.cli", "gcodekit.testing", "gcodekit.path", "gcodekit"),
 ]
 #: Where an import may reach a later stage: the Operation's convenience methods, lazily, into the outputs.
 CONVENIENCE = (("gcodekit.model.operation", "gcodekit.model.processes"), 8)
@@ -205,6 +205,7 @@ SIGNALS = {
     "gcodekit.preprocess.flow.run.Stop": "ends the program counter's run (a program end or a limit)",
     "gcodekit.preprocess.wizards.arguments.BadCall": "becomes a diagnostic at the call's column",
     "gcodekit.pipeline.feedback.MachineStop": "carries the machine's GcodeError through the parameter stage",
+    "gcodekit.path.rules._Problem": "becomes a FreeCADFormatError or a diagnostic at its column",
 }
 
 

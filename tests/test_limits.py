@@ -129,3 +129,34 @@ def test_the_command_line_sets_the_limits(tmp_path, capsys):
     assert "more than max_motions=10 blocks" in out
     with pytest.raises(SystemExit):
         run(["info", program, "--max-motions", "0"], capsys)
+
+
+NESTED_LOOPS = ("G21 G90 G1 F100\n#1 = 0\no100 repeat [1000]\n  o200 repeat [1000]\n    #1 = [#1 + 1]\n"
+                "  o200 endrepeat\no100 endrepeat\nG1 X1\nM2\n")
+
+
+@pytest.mark.parametrize("command", [["translate"], ["export", "--to", "csv"], ["export", "--to", "events"],
+                                     ["render", "-o", "{tmp}/out.png"]])
+def test_every_command_stops_at_the_limit_with_infos_message(tmp_path, capsys, command):
+    # two nested repeat [1000] loops: each outer turn runs 999 inner repeats and one outer repeat, 1000
+    # iterations, so after two turns max_iterations=2,000 is spent and the third turn's 999 are refused
+    program = tmp_path / "loops.ngc"
+    program.write_text(NESTED_LOOPS)
+    limits = ["--max-iterations", "2000"]
+    status, out, _ = run(["info", program, *limits], capsys)
+    message = f"{program}:4:3: error: o200 repeat [1000]: 999 repeats, more than the 0 iterations left of " \
+              "max_iterations=2,000"
+    assert status == 0 and message in out  # info reports it in its summary
+    if command[0] == "render":
+        pytest.importorskip("pyvista")
+    status, out, err = run([*(c.format(tmp=tmp_path) for c in command), program, *limits], capsys)
+    assert status == 1 and message in err  # a partial output: said, and a failing status
+
+
+def test_notebook_reads_the_program_under_the_limits(tmp_path, capsys):
+    pytest.importorskip("nbformat")
+    program = tmp_path / "loops.ngc"
+    program.write_text(NESTED_LOOPS)
+    status, _, _ = run(["notebook", program, "-o", tmp_path / "n.ipynb", "--max-iterations", "2000"], capsys)
+    text = (tmp_path / "n.ipynb").read_text()
+    assert status == 0 and "max_iterations = 2000" in text and "max_iterations=max_iterations" in text

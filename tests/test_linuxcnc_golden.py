@@ -1,7 +1,7 @@
 """Golden tests: motions of LinuxCNC example programs against rs274's canon.
 
 Cases and their reference tables sit in ``tests/golden/linuxcnc/cases`` (see
-the README there; ``regenerate.py`` selects and refreshes them).  The canon
+the README there; ``make_slicer_files.py`` selects and refreshes them).  The canon
 gives program coordinates plus the offsets in force, so each reference row is
 moved to machine coordinates first: rotate(program + G92, XY rotation) + G5x
 + tool offset, all in the program units of that move.

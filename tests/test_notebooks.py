@@ -45,7 +45,7 @@ HAND_ANSWERS = {
     },
 }
 
-ALL = ["explore.ipynb"] + [f"worksheets/{name}.ipynb" for name in HAND_ANSWERS]
+ALL = ["explore.ipynb", "freecad_path.ipynb"] + [f"worksheets/{name}.ipynb" for name in HAND_ANSWERS]
 
 
 def _answered(path: Path):

@@ -93,3 +93,17 @@ def test_notebook_command_runs_from_the_wheel(installed, tmp_path):
                           cwd=tmp_path, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert "LayerViewer(op)" in (tmp_path / "cube.ipynb").read_text()
+
+
+def test_freecad_path_api_runs_from_the_wheel(installed, tmp_path):
+    """gcodekit.path (a front end) ships: a job post-processed and pre-processed from the installed wheel."""
+    python, _, _ = installed
+    script = ("import gcodekit.path as Path\n"
+              "job = Path.Job(tooltable=Path.Tooltable([Path.Tool('e', tooltype='EndMill', diameter=3)]))\n"
+              "job.add(Path.Path('G0 Z5 G1 X10 F100 G2 X10 Y0 I-5 J0'), tool=1)\n"
+              "text = Path.post_process(job, 'fanuc')\n"
+              "print(Path.__file__); print(round(Path.read(text, machine='fanuc').Length, 4))\n")
+    out = subprocess.run([str(python), "-I", "-c", script], check=True, capture_output=True, text=True,
+                         cwd=tmp_path).stdout.split()
+    assert not out[0].startswith(str(ROOT / "gcodekit"))
+    assert float(out[1]) == pytest.approx(5 + 10 + 10 * 3.141592653589793, abs=1e-3)  # up, along, a whole circle

@@ -144,7 +144,10 @@ def test_detect_fff_corpus(shared_dir):
     files = sorted((shared_dir / "corpus" / "fff").glob("*.gcode"))
     assert files
     for path in files:
-        expected = "klipper" if path.name == "cube20_klipper.gcode" else "marlin"
+        # PrusaSlicer's MK3S files check the printer (M862.3 P "MK3S"): Prusa's firmware, a Marlin fork
+        text = _head(path)
+        expected = ("klipper" if path.name == "cube20_klipper.gcode" else
+                    "prusa" if 'M862.3 P "MK3S"' in text else "marlin")
         assert detect_flavor(_head(path), path.name).name == expected, path.name
         assert detect_flavor(_head(path)).name == expected, path.name
 

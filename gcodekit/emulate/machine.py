@@ -346,9 +346,11 @@ class Machine:
             self._arcs(t, start, np.flatnonzero(is_arc), program_start, targets, centers, distance)
         rotary = np.sqrt(np.einsum("ij,ij->i", delta[:, 3:], delta[:, 3:]))
         speed = self._spindle_speeds(t, rows, kind)
+        no_spindle = np.zeros(n, bool)
         if s.feed_mode == "per_rev":  # G95: F is mm per spindle revolution
+            no_spindle = (feed > 0) & ((speed == 0) | (s.spindle == 0))
             feed = feed * np.abs(speed) * (s.spindle != 0)
-        time = self._durations(t, rows, kind, motion, distance, rotary, de, feed)
+        time = self._durations(t, rows, kind, motion, distance, rotary, de, feed, no_spindle)
 
         for ax, letter in enumerate(AXES.lower()):
             out[letter][rows] = position[:, ax]
@@ -485,8 +487,11 @@ class Machine:
                                     f"radius to end of arc differs from radius to start by {abs(r1[i] - r0[i]):.4g} mm",
                                     kind="machine")
 
-    def _durations(self, t, rows, kind, motion, distance, rotary, de, feed) -> np.ndarray:
-        """Time of each row: length over feed (the planner refines this later)."""
+    def _durations(self, t, rows, kind, motion, distance, rotary, de, feed, no_spindle) -> np.ndarray:
+        """Time of each row: length over feed (the planner refines this later).
+
+        ``no_spindle``: rows with a feed per revolution (G95) in force and the spindle stopped.
+        """
         s = self.state
         n = kind.size
         time = np.zeros(n)
@@ -496,6 +501,22 @@ class Machine:
         if s.feed_mode == "inverse_time":
             with np.errstate(divide="ignore"):
                 time[feeding] = 60.0 / feed[feeding]
+            missing = feeding & np.isnan(feed)  # G93 wants an F word on every feed move
+            if missing.any():
+                first = int(np.flatnonzero(missing)[0])
+                arc = motion[first] in (MOTION_CW, MOTION_CCW)
+                if self.rs274_blocks:
+                    self.diagnostics.report(int(t.line[rows][first]), 1, "F word missing with inverse time "
+                                            f"{'arc' if arc else 'g1'} move", kind="machine")
+                else:
+                    self.warn_once("inverse time F", int(t.line[rows][first]), "inverse time move (G93) without an "
+                                   "F word; its time is unknown")
+            never = feeding & (feed == 0) & ((path > 0) | (rotary > 0))
+            if never.any():  # rs274 accepts F0 in G93; the move would take forever
+                time[never] = np.nan
+                for i in np.flatnonzero(never)[:20]:
+                    self.diagnostics.warn(int(t.line[rows][i]), 1, "inverse time move (G93) with F0: it never ends "
+                                          "(a controller stalls); its time is unknown")
         else:
             rate = np.where(rapid, feed if self.rapid_is_feed else self.config.rapid_feed, feed)
             moving = feeding | rapid
@@ -506,11 +527,17 @@ class Machine:
                 # RS274NGC refuses the block (interp_convert.cc), moving or not
                 first = int(np.flatnonzero(feeding & ~(rate > 0))[0])
                 arc = motion[first] in (MOTION_CW, MOTION_CCW)
-                self.diagnostics.report(int(t.line[rows][first]), 1, "Cannot make arc with zero feed rate" if arc
-                                        else "Cannot do g1 with zero feed rate", kind="machine")
+                message = ("Cannot feed with zero spindle speed in feed per rev mode" if no_spindle[first] else
+                           "Cannot make arc with zero feed rate" if arc else "Cannot do g1 with zero feed rate")
+                self.diagnostics.report(int(t.line[rows][first]), 1, message, kind="machine")
             elif bad.any():
                 first = int(np.flatnonzero(bad)[0])
-                self.warn_once("feed", int(t.line[rows][first]), "move with no feed rate (F) in force; its time is unknown")
+                if no_spindle[first]:
+                    self.warn_once("feed per rev", int(t.line[rows][first]), "feed per revolution (G95) with the "
+                                   "spindle stopped: the move never ends (a controller stalls); its time is unknown")
+                else:
+                    self.warn_once("feed", int(t.line[rows][first]),
+                                   "move with no feed rate (F) in force; its time is unknown")
                 time[bad] = np.nan
         dwell = kind == Kind.DWELL
         if dwell.any():

@@ -99,11 +99,12 @@ class ModalHandler:
             s.note_move()
         if outcome.believed is not None:
             s.keep_program_position(outcome.believed)
-        for w in outcome.passed:
+        passed = _dwells_apart(outcome.passed)
+        for w in passed:
             self._fill_passing(w, before)
             before = np.array([w.values[k] for k in AXES.lower()])
         self._write(out, row, before, outcome)
-        return outcome.passed
+        return passed
 
     def _read_feed(self, block: Block) -> None:
         """An F word sets the feed (in RS274NGC whatever else the block does; on firmware not beside an M code)."""
@@ -123,8 +124,7 @@ class ModalHandler:
         distance = self._length(before, point, motion, [w.values.get(k, np.nan) for k in ("cx", "cy", "cz")])
         rate = w.values["feed"] if "feed" in w.values and motion != MOTION_RAPID else self._rate(motion)
         dwell = w.values.pop("dwell", 0.0)
-        w.values.update(distance=distance, time=(distance / (rate / 60.0) if distance and rate > 0 else 0.0) + dwell,
-                        de=0.0)
+        w.values.update(distance=distance, time=_duration(distance, rate, "feed" in w.values) + dwell, de=0.0)
         for k in ("cx", "cy", "cz"):
             w.values.setdefault(k, np.nan)
 
@@ -152,10 +152,32 @@ class ModalHandler:
         rate = self._rate(outcome.motion) if outcome.feed is None else outcome.feed
         path = distance or abs(outcome.de)
         out["distance"][row] = distance
-        out["time"][row] = (path / (rate / 60.0) if path and rate > 0 else 0.0) + outcome.dwell
+        out["time"][row] = _duration(path, rate, outcome.feed is not None) + outcome.dwell
         out["de"][row] = outcome.de
         out["feed"][row] = rate if outcome.feed is not None else s.feed
         out["motion"][row] = outcome.motion
         out["cx"][row], out["cy"][row], out["cz"][row] = outcome.centre
         out["spindle"][row] = s.speed * s.spindle
         s.fill_columns(row, out)
+
+
+def _duration(path: float, rate: float, rate_given: bool) -> float:
+    """Seconds to travel ``path`` mm at ``rate`` mm/min; NaN (unknown: the move never ends) when the
+    handler gave the move a rate of zero (a synchronized move at zero pitch or spindle speed)."""
+    if path and rate > 0:
+        return path / (rate / 60.0)
+    return float("nan") if path and rate_given else 0.0
+
+
+def _dwells_apart(passed: list[Waypoint]) -> list[Waypoint]:
+    """A cycle's dwell at a point it passes (G82, G86, G89 at the bottom) as a waypoint of its own that does
+    not move, so planners time the move before it at its feed and the machine at rest for the dwell."""
+    if not any(w.values.get("dwell") for w in passed):
+        return passed
+    out = []
+    for w in passed:
+        dwell = w.values.pop("dwell", 0.0)
+        out.append(w)
+        if dwell:
+            out.append(Waypoint({**{k: w.values[k] for k in AXES.lower()}, "motion": MOTION_NONE, "dwell": dwell}))
+    return out

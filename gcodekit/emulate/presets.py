@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import os
+import re
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -147,6 +148,10 @@ class MachineConfig:
     screw_displacement : float
         cm^3 of material a screw extruder delivers per revolution; 0 leaves
         its deposited volume unknown (NaN).
+    printer_names : tuple of str
+        What slicers call this printer in the files they write (Cura 5's
+        ``;TARGET_MACHINE.NAME:``, the Slic3r family's ``; printer_model =``):
+        a file naming one is run on this preset when no machine is given.
     """
 
     name: str
@@ -185,6 +190,7 @@ class MachineConfig:
     cycle_retract: str = "initial"
     table_axis: str = ""
     screw_displacement: float = 0.0
+    printer_names: tuple[str, ...] = ()
 
     def __hash__(self) -> int:
         return hash(self.name)
@@ -257,6 +263,7 @@ def _build(data: dict, path: Path) -> MachineConfig:
     if isinstance(path_list, str):
         path_list = [p for p in path_list.split(":") if p]
     data = {**data, "work_offsets": MappingProxyType(offsets), "subroutine_path": tuple(map(str, path_list)),
+            "printer_names": tuple(map(str, data.get("printer_names", ()))),
             "planner_settings": MappingProxyType(dict(data.get("planner_settings", data.pop("planner_table", {}))))}
     if "name" not in data:
         data["name"] = path.stem
@@ -266,8 +273,31 @@ def _build(data: dict, path: Path) -> MachineConfig:
 _WORK_OFFSET_CODES = ("G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3")
 
 
+_PRINTER_NAME = re.compile(r"^;\s*(?:TARGET_MACHINE\.NAME:|printer_model\s*=)\s*(.+?)\s*$", re.M)
+
+
+def machine_named_in(head: str, flavor: str) -> str | None:
+    """The preset of ``flavor`` whose ``printer_names`` has the printer a file's header names, or None.
+
+    Examples
+    --------
+    >>> machine_named_in(";FLAVOR:Marlin\\n;TARGET_MACHINE.NAME:Creality Ender-3\\n", "marlin")
+    'creality_ender3'
+    """
+    named = {m[1].casefold() for m in _PRINTER_NAME.finditer(head)}
+    if not named:
+        return None
+    for name in list_machines():
+        config = _load((MACHINE_DIR / f"{name}.toml").resolve())
+        if config.flavor == flavor and named & {p.casefold() for p in config.printer_names}:
+            return name
+    return None
+
+
 def default_machine_for(flavor: str) -> str:
-    """The preset that runs a flavor when the user names no machine."""
+    """The preset that runs a flavor when the user names no machine: the one named after it, else the first."""
+    if (MACHINE_DIR / f"{flavor}.toml").exists() and _load((MACHINE_DIR / f"{flavor}.toml").resolve()).flavor == flavor:
+        return flavor
     for name in list_machines():
         if _load((MACHINE_DIR / f"{name}.toml").resolve()).flavor == flavor and name != "generic":
             return name

@@ -30,7 +30,7 @@ from ..parse.table import MOTION_NAMES, CommandTable
 from ..schema import COLUMNS, WAYPOINT_COLUMNS
 from ..syntax.flavor import code_label
 from ..units import MM_PER_INCH
-from . import derived, statistics
+from . import derived, slicer, statistics
 from .process_data import LazyList, ProcessData
 
 if TYPE_CHECKING:
@@ -40,6 +40,7 @@ if TYPE_CHECKING:
     from ..plan import Plan
     from ..plan.moves import PlannedMoves, PlanResult
     from ..syntax import Flavor
+    from .slicer import SlicerFigures
 
 
 #: Columns only a planned operation has
@@ -167,6 +168,13 @@ class Operation:
                              "meaning": [c.meaning for c in shown]},
                             index=pd.Index([c.name for c in shown], name="column"))
 
+    def slicer_figures(self) -> "SlicerFigures":
+        """What the slicer wrote into the file: its name, estimated time, filament, layers and progress marks.
+
+        See :mod:`gcodekit.model.slicer`; computed once.
+        """
+        return self._kept("slicer_figures", lambda: slicer.slicer_figures(self))
+
     def summary(self) -> dict[str, Any]:
         """The one summary record (see :func:`gcodekit.model.statistics.summary`)."""
         return statistics.summary(self)
@@ -289,6 +297,16 @@ class Operation:
         from ..analysis import time_by
 
         return time_by(self, key)
+
+    def slicer_layer_times(self, mode: str = "normal") -> "pd.DataFrame":
+        """Planned time by layer beside the slicer's progress marks (see :func:`gcodekit.analysis.slicer_layer_times`)."""
+        import pandas as pd
+
+        if not self._require_emulation("slicer_layer_times()"):
+            return pd.DataFrame()
+        from ..analysis import slicer_layer_times
+
+        return slicer_layer_times(self, mode)
 
     def velocity_profile(self) -> "pd.DataFrame":
         """Planned and commanded speed over time (see :func:`gcodekit.analysis.velocity_profile`)."""

@@ -76,8 +76,10 @@ def summary(op: "Operation") -> dict[str, Any]:
     bounds, distance_mm, time_s, layers, filament_mm, filament_convention,
     filament_pushed_mm, volume_mm3, mass_g, tools, diagnostics`` (each with
     its ``file``, ``line``, ``column``, ``severity``, ``message``, ``text``),
-    ``diagnostics_dropped``, ``diagnostics_total`` and ``errors``.  Volume and
-    mass are made from ``filament_mm`` for filament printers, else None.
+    ``diagnostics_dropped``, ``diagnostics_total``, ``errors`` and ``slicer``
+    (what the slicer wrote into the file, :meth:`SlicerFigures.as_dict`, or
+    None).  Volume and mass are made from ``filament_mm`` for filament
+    printers, else None.
     """
     stats = op.get_statistics()
     machine = op.machine
@@ -96,7 +98,11 @@ def summary(op: "Operation") -> dict[str, Any]:
         "diagnostics_dropped": op.diagnostics.dropped,
         "diagnostics_total": len(op.diagnostics) + op.diagnostics.dropped,
         "errors": sum(1 for d in op.diagnostics if d.severity == "error"),
+        "slicer": None,
     }
+    figures = op.slicer_figures()
+    if figures.slicer is not None or figures.time_s is not None or figures.filament_mm is not None:
+        record["slicer"] = figures.as_dict()
     if stats["filament_mm"]:
         volume = stats["filament_mm"] * op.filament_area
         record["volume_mm3"] = volume

@@ -16,6 +16,8 @@ Examples
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from ..errors import Diagnostics
@@ -30,6 +32,9 @@ from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CCW, MOTION_CUBIC, MO
                     MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable)
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
+#: LinuxCNC's log comments: (LOGOPEN,file), (LOGAPPEND,file), (LOG,text), (LOGCLOSE)
+_LOG_COMMENT = re.compile(rb"(?i)\s*(?:log(?:open|append)?\s*,|logclose\s*$)")
+_LOG_HINT = re.compile(rb"(?i)log")
 _KEEP = 255  # "this row does not set the motion mode"
 #: Parameter letters and their row in the per-chunk parameter table.
 PARAM_LETTERS = "ABCDEFGHIJKLMNOPQRSTUVWXYZ@^"
@@ -68,11 +73,27 @@ class GcodeParser:
         self._unknown_reported: set[str] = set()
         self._cycle_ids = np.array([NAME_ID[n] for n in CYCLE_NAMES], np.uint8)
         self._lathe_ids = np.array([NAME_ID[n] for n in LATHE_CYCLE_NAMES], np.uint8)
+        self._log_comments = self.flavor.state_parameters == "linuxcnc"  # said once per program
+
+    def _note_log_comment(self, blocks: Blocks) -> None:
+        """Warn, once, at LinuxCNC's first ``(LOGOPEN,...)``, ``(LOGAPPEND,...)``, ``(LOG,...)`` or
+        ``(LOGCLOSE)`` comment: the interpreter writes such comments to a log file; gcodekit writes none."""
+        offsets, data = blocks.comment_offsets, blocks.comment_data
+        for k in range(len(offsets) - 1):
+            if _LOG_COMMENT.match(data[offsets[k]:offsets[k + 1]]):
+                line = int(blocks.block_line[blocks.comment_block[k]])
+                self.diagnostics.warn(line, int(blocks.comment_col[k]), "LinuxCNC writes (LOG,...) comments to the "
+                                      "file (LOGOPEN,...) opens; gcodekit runs them as plain comments and writes no "
+                                      "log file")
+                self._log_comments = False
+                return
 
     # -- public ---------------------------------------------------------------
 
     def parse(self, blocks: Blocks) -> CommandTable:
         """Commands of ``blocks``, continuing the modal state of earlier calls."""
+        if self._log_comments and _LOG_HINT.search(blocks.comment_data):
+            self._note_log_comment(blocks)
         n_blocks = len(blocks)
         wb, wl = blocks.word_block, blocks.word_letter
         is_code = (wl == _G) | (wl == _M)
@@ -390,7 +411,11 @@ class GcodeParser:
                 continue
             self._unknown_reported.add(code)
             line = int(t["line"][i])
-            if self.flavor.other_codes and code not in self.flavor.other_codes:
+            what = self.flavor.firmware_codes.get(code)
+            if what is not None:
+                self.diagnostics.report(line, 1, f"{code} ({what}) is a {self.flavor.name} code gcodekit does not "
+                                        "model; kept as a generic command", severity="info")
+            elif self.flavor.other_codes and code not in self.flavor.other_codes:
                 # the dialect's list is complete: LinuxCNC stops here (convert_g / convert_m)
                 self.diagnostics.report(line, 1, f"Unknown {code[0].lower()} code used: {code} "
                                         f"is not a {self.flavor.name} code", kind="machine")

@@ -22,6 +22,8 @@ import dataclasses
 import os
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..emulate.compensation import compensate, uses_compensation
 from ..emulate.presets import MachineConfig, load_machine
 from ..errors import ConfigError, Diagnostics, GcodeError, check_choice
@@ -33,7 +35,7 @@ from ..plan import machine_options as firmware_options
 from ..plan import planner_settings, run_planner
 from ..read import Blocks
 from ..syntax import Flavor
-from .assemble import concat_waypoints, empty_table, new_machine, raise_first_run
+from .assemble import concat_waypoints, empty_table, new_machine, raise_first_run, warn_implausible_time
 from .program import Program, as_program, check_program_end, note_weak_detection, progress_bar, quote_diagnostics, resolve
 from .source import program_blocks, restore_line_numbers
 
@@ -133,11 +135,43 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         diagnostics.extend(op.diagnostics)  # its warnings
         op.diagnostics = diagnostics
     if plan and config.planner:
-        op.attach_plan(run_planner(op, config.planner,
-                                   planner_settings(config.planner, config.planner_settings, machine_config)))
+        settings = planner_settings(config.planner, config.planner_settings, machine_config)
+        if config.planner == "marlin" and machine_config is None:
+            settings = _with_slicer_limits(op, settings, chosen=machine is not None)
+        op.attach_plan(run_planner(op, config.planner, settings))
+    warn_implausible_time(op)
     restore_line_numbers(op.table, diagnostics)
     quote_diagnostics(op.diagnostics, program)
     return op
+
+
+def _with_slicer_limits(op: Operation, settings, chosen: bool):
+    """The Marlin planner's settings with the machine limits the slicer assumed, for a file that writes none.
+
+    PrusaSlicer and its forks keep the printer's limits in the configuration
+    block at the end of the file; when the program sets none itself (no
+    M201, M203, M204 or M205, PrusaSlicer's ``time_estimate_only``), those
+    are the limits its estimate assumed, and they replace the preset's.
+    Cura keeps them in its printer definition, outside the file: when the
+    user ``chosen`` no machine, an info says so.
+    """
+    from ..parse.table import NAME_ID
+    from ..plan.marlin import limits_from_slicer
+
+    codes = [NAME_ID[n] for n in ("set_max_accel", "set_max_feed", "set_accel", "set_jerk")]
+    if np.isin(op.table.name, codes).any():
+        return settings
+    figures = op.slicer_figures()
+    limits = limits_from_slicer(figures.settings)
+    if not limits:
+        if figures.family == "cura" and not chosen and not op.machine.printer_names:
+            op.diagnostics.report(1, 1, f"{figures.slicer} wrote no machine limits into the file (its estimate used "
+                                  "its printer definition's); planned with the preset's: give the printer with "
+                                  "--machine (machine=), e.g. creality_ender3", severity="info")
+        return settings
+    op.diagnostics.report(1, 1, "planned with the machine limits in the slicer's configuration block (the program "
+                          "sets none with M201-M205)", severity="info")
+    return dataclasses.replace(settings, **limits)
 
 
 def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits,

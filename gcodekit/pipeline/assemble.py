@@ -7,14 +7,14 @@ import numpy as np
 from ..emulate.machine import Machine
 from ..emulate.presets import MachineConfig
 from ..errors import Diagnostics, GcodeError
-from ..limits import Limits
+from ..limits import PLAUSIBLE_TIME_S, Limits
 from ..model.operation import Operation
 from ..parse import CommandTable, GcodeParser
 from ..read import Blocks
 from ..syntax import Flavor
 from .program import Program, quote_diagnostics
 
-__all__ = ["new_machine", "empty_table", "concat_waypoints", "raise_first_run"]
+__all__ = ["new_machine", "empty_table", "concat_waypoints", "raise_first_run", "warn_implausible_time"]
 
 
 def new_machine(flavor: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits = Limits()) -> Machine:
@@ -72,3 +72,17 @@ def raise_first_run(op: Operation, program: Program, reading_error: GcodeError |
         return first_row.get(number, len(lines)), k
 
     found.raise_item(min(errors, key=ran_at))
+
+
+def warn_implausible_time(op: Operation) -> None:
+    """A warning, at its longest step, when the program would run longer than
+    :data:`~gcodekit.limits.PLAUSIBLE_TIME_S` (a year): a runaway arc, dwell or feed, not a real job."""
+    time = np.nan_to_num(np.asarray(op.waypoints["time"], float))
+    total = float(time.sum())
+    if not total > PLAUSIBLE_TIME_S:
+        return
+    longest = int(np.argmax(time))
+    row = int(op.waypoints["command"][longest])
+    years = total / (365.25 * 86400.0)
+    op.diagnostics.warn(int(op.table.line[row]), 1, f"the program would run for {years:,.1f} years (more than a "
+                        f"year, no real job); this step alone takes {time[longest] / 86400.0:,.1f} days")

@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 from typing import Iterator
 
-from ..emulate.presets import MachineConfig, default_machine_for, load_machine, with_options
+from ..emulate.presets import MachineConfig, default_machine_for, load_machine, machine_named_in, with_options
 from ..errors import Diagnostics
 from ..parse import CommandTable
 from ..parse.table import NAME_ID
@@ -85,7 +85,7 @@ def resolve(program: Program, machine: str | MachineConfig | None, flavor: str |
         detection = detect_flavor(program.head(), program.name if program.path else None)
         fl = load_flavor(detection.name)
     if config is None:
-        config = load_machine(default_machine_for(fl.name))
+        config = load_machine(machine_named_in(program.head(), fl.name) or default_machine_for(fl.name))
     if machine_options:
         config = with_options(config, **machine_options)
     return fl, config, detection

@@ -30,7 +30,8 @@ import numpy as np
 from ..errors import ConfigError
 from ..parse.table import MOTION_RAPID
 from .lookahead import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
-from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before
+from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, follows_kept_step, happens_before,
+                    with_kept_steps)
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -158,9 +159,23 @@ def plan(op: "EmulatedProgram", config: GrblConfig) -> tuple[PlannerMoves, PlanR
     """
     moves = firmware_moves(op, None, lambda travel, angle, radius, speed_v: arc_segments(travel, angle, radius,
                                                                                  config.arc_tolerance))
+    w = op.waypoints
+    # arcs too long to cut into chords within max_motions keep the emulator's time, at rest around them
+    has_move = np.zeros(w["x"].size, bool)
+    has_move[moves.waypoint] = True
+    unplanned = np.flatnonzero((w["motion"] >= 3) & ~has_move & (w["distance"] > 0))
+    if len(moves) == 0:
+        return with_kept_steps(w, moves, empty_result(), unplanned) if unplanned.size else (moves, empty_result())
+    dwells = np.flatnonzero((w["motion"] == 0) & (np.asarray(w["time"], float) > 0))  # G4, and dwells in cycles
+    rest_before = follows_kept_step(moves, unplanned) | follows_kept_step(moves, dwells)
+    moves, result = _plan_moves(op, moves, config, rest_before)
+    return with_kept_steps(w, moves, result, unplanned) if unplanned.size else (moves, result)
+
+
+def _plan_moves(op: "EmulatedProgram", moves: PlannerMoves, config: GrblConfig,
+                rest_before: np.ndarray) -> tuple[PlannerMoves, PlanResult]:
+    """GRBL's lookahead over the firmware moves; ``rest_before``: moves that start from rest."""
     n = len(moves)
-    if n == 0:
-        return moves, empty_result()
     w = op.waypoints
     axes_d = moves.axes_d
     move_d, unit_vec = unit_vectors([axes_d[:, a] for a in range(3)])
@@ -176,7 +191,8 @@ def plan(op: "EmulatedProgram", config: GrblConfig) -> tuple[PlannerMoves, PlanR
     nominal = np.where(rapid, rapid_rate, np.minimum(programmed, rapid_rate))
     nominal = np.maximum(np.nan_to_num(nominal, nan=MINIMUM_FEED_RATE), MINIMUM_FEED_RATE)
 
-    rest_before = happens_before(moves, command_rows(op, names=REST_NAMES)) | _spindle_syncs(op, moves, config)
+    rest_before = rest_before | happens_before(moves, command_rows(op, names=REST_NAMES))
+    rest_before |= _spindle_syncs(op, moves, config)
     rest_before[0] = True
 
     # junction: grbl planner.c, "Compute maximum allowable entry speed at junction by centripetal acceleration"

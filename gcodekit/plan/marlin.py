@@ -33,7 +33,7 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 
@@ -156,6 +156,52 @@ class MarlinConfig:
         if not seen:
             raise ConfigError(f"{path}: no M201/M203/M204/M205 lines (is this a Marlin M503 report?)")
         return cls(**values)
+
+
+#: MarlinConfig fields from the machine limits the Slic3r family keeps in its configuration block
+#: (PrusaSlicer and SuperSlicer ``machine_max_feedrate_x``; OrcaSlicer and Bambu Studio ``machine_max_speed_x``).
+_SLICER_LIMITS = {
+    **{f"machine_max_{kind}_{a}": f"max_{field}_{a}" for a in "xyze"
+       for kind, field in (("acceleration", "acceleration"), ("feedrate", "feedrate"), ("speed", "feedrate"),
+                           ("jerk", "jerk"))},
+    "machine_max_acceleration_extruding": "acceleration",
+    "machine_max_acceleration_retracting": "retract_acceleration",
+    "machine_max_acceleration_travel": "travel_acceleration",
+    "machine_min_extruding_rate": "min_feedrate",
+    "machine_min_travel_rate": "min_travel_feedrate",
+}
+
+
+def limits_from_slicer(settings: "Mapping[str, str]") -> dict[str, float | bool]:
+    """MarlinConfig values from a slicer's printer settings (``machine_max_acceleration_x = 1000,960``).
+
+    The first value of each list is the normal mode's (the second is
+    PrusaSlicer's silent mode).  Empty when the settings carry no limits or
+    say the slicer ignored them (``machine_limits_usage = ignore``).  A
+    travel acceleration of 0 (PrusaSlicer's "same as printing") is left out.
+    The Slic3r family estimates with classic jerk; a junction deviation
+    above 0 (OrcaSlicer's ``machine_max_junction_deviation``) switches to it.
+
+    Examples
+    --------
+    >>> limits_from_slicer({"machine_max_acceleration_x": "1000,960", "machine_max_jerk_x": "8,8"})
+    {'max_acceleration_x': 1000.0, 'max_jerk_x': 8.0, 'classic_jerk': True}
+    """
+    if settings.get("machine_limits_usage", "").strip() == "ignore":
+        return {}
+    out: dict[str, float | bool] = {}
+    for key, field in _SLICER_LIMITS.items():
+        value = re.match(r"\s*([-+]?\d*\.?\d+)", settings.get(key, ""))
+        if value and not (field == "travel_acceleration" and float(value[1]) == 0):
+            out[field] = float(value[1])
+    if not out:
+        return {}
+    deviation = re.match(r"\s*(\d*\.?\d+)", settings.get("machine_max_junction_deviation", ""))
+    if deviation and float(deviation[1]) > 0:
+        out.update(classic_jerk=False, junction_deviation=float(deviation[1]))
+    else:
+        out["classic_jerk"] = True
+    return out
 
 
 def _m20x_settings(code: int, words: dict[str, float]) -> dict[str, float | bool]:

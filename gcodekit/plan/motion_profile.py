@@ -7,15 +7,18 @@ For machines without a firmware model of their own (``generic``,
 Each move keeps the speed the emulator gave it (its path length over its
 time), so rapids, inverse-time and per-revolution feeds plan at the speed
 the machine was asked for.  Arcs are cut into chords of at most
-``arc_resolution`` mm, each capped at the speed whose centripetal
-acceleration on the arc's radius is ``max_acceleration``.  The machine
+``arc_resolution`` mm (every turn of a multi-turn arc or helix), each
+capped at the speed whose centripetal acceleration on the arc's radius is
+``max_acceleration`` and measured as its share of the arc's length: the
+machine follows the arc, not the chords.  The machine
 comes to rest where LinuxCNC's task waits for motion to finish before the
 next command (``emctaskmain.cc``, ``emcTaskCheckPreconditions``): dwells,
 tool changes, spindle and coolant commands, program stops and ends,
 homing, probing, and offset changes; and after every move in exact-stop
 mode (G61, G61.1).  Steps without a planner move (rotary axes only; G28
-and G30, which ``firmware_moves`` leaves out as homing) keep the
-emulator's time and the linear axes stop around them.
+and G30, which ``firmware_moves`` leaves out as homing; arcs too long to
+cut into chords within ``max_motions``) keep the emulator's time and the
+linear axes stop around them.
 """
 
 from __future__ import annotations
@@ -30,7 +33,8 @@ from ..errors import ConfigError, check_choice
 from ..emulate import arcs
 from ..parse.table import NAME_ID
 from .profile import BAAMMotionProfile, MotionProfile
-from .moves import PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force
+from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, follows_kept_step, happens_before,
+                    in_force, with_kept_steps)
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -137,17 +141,26 @@ def plan(op: "EmulatedProgram", config: MotionProfileConfig) -> tuple[PlannerMov
     kept = np.flatnonzero((w["motion"] > 0) & ~has_move & (time != 0))
 
     stop_before = happens_before(moves, command_rows(op, names=STOP_NAMES))
-    if kept.size and len(moves):
-        previous_wp = np.r_[-1, moves.waypoint[:-1]]
-        stop_before |= np.searchsorted(kept, moves.waypoint) > np.searchsorted(kept, previous_wp)
+    stop_before |= follows_kept_step(moves, kept)
+    stop_before |= follows_kept_step(moves, np.flatnonzero((w["motion"] == 0) & (time > 0)))  # dwells in cycles
     exact_rows = command_rows(op, names=("exact_stop", "path_blending"))
     exact = in_force(moves, exact_rows, op.table.name[exact_rows] == NAME_ID["exact_stop"], 0.0) > 0
     last_of_step = np.append(moves.waypoint[1:] != moves.waypoint[:-1], True)[:len(moves)]
     stops = np.append(stop_before[1:], True)[:len(moves)] | (exact & last_of_step)
-    result = config.motion_profile().plan(moves, stops=stops)
+    result = config.motion_profile().plan(moves, stops=stops, length_d=_path_lengths(w, moves, is_arc))
     if kept.size:
-        moves, result = _with_kept_steps(w, moves, result, kept)
+        moves, result = with_kept_steps(w, moves, result, kept)
     return moves, result
+
+
+def _path_lengths(w, moves: PlannerMoves, is_arc: np.ndarray) -> np.ndarray:
+    """Per move: its length, an arc's chords each their share of the arc's length (the machine follows the
+    arc, not its chords)."""
+    axes_d = moves.axes_d[:, :3]
+    length_d = np.sqrt(np.einsum("ij,ij->i", axes_d, axes_d))
+    chords = np.bincount(moves.waypoint, minlength=w["x"].size)[moves.waypoint]
+    arc_share = np.asarray(w["distance"], float)[moves.waypoint] / chords
+    return np.where(is_arc, arc_share, length_d)
 
 
 def _arc_radius(w) -> np.ndarray:
@@ -162,23 +175,3 @@ def _arc_radius(w) -> np.ndarray:
         sel = plane == code
         radius[sel] = np.hypot(start[sel, f] - centre[sel, f], start[sel, g] - centre[sel, g])
     return radius
-
-
-def _with_kept_steps(w, moves: PlannerMoves, result: PlanResult, kept: np.ndarray):
-    """Insert the steps the planner has no move for, in program order, at the emulator's time."""
-    k = kept.size
-    position = np.column_stack([w["x"], w["y"], w["z"], np.cumsum(w["de"])])[kept]
-    rows = w["command"][kept]
-    extra = PlannerMoves(position, position.copy(), np.asarray(w["feed"], float)[kept] / 60.0, rows, kept)
-    zero = np.zeros(k)
-    extra_result = PlanResult(zero, zero, zero, np.full(k, np.inf), zero, np.asarray(w["time"], float)[kept], zero)
-    order = np.argsort(np.r_[moves.waypoint, kept], kind="stable")
-
-    def merged(a, b):
-        return np.concatenate([a, b])[order]
-
-    moves = PlannerMoves(*(merged(getattr(moves, f), getattr(extra, f))
-                           for f in ("start", "end", "speed_v", "row", "waypoint")))
-    result = PlanResult(*(merged(getattr(result, f), getattr(extra_result, f))
-                          for f in ("start_v", "cruise_v", "end_v", "accel", "accel_t", "cruise_t", "decel_t")))
-    return moves, result

@@ -193,6 +193,14 @@ def happens_before(moves: PlannerMoves, rows: np.ndarray) -> np.ndarray:
     return (count_before > 0) & ~same_row
 
 
+def follows_kept_step(moves: PlannerMoves, kept: np.ndarray) -> np.ndarray:
+    """Per move: does one of the waypoints ``kept`` (sorted) come between the previous move and this one?"""
+    if kept.size == 0 or len(moves) == 0:
+        return np.zeros(len(moves), bool)
+    previous_wp = np.r_[-1, moves.waypoint[:-1]]
+    return np.searchsorted(kept, moves.waypoint) > np.searchsorted(kept, previous_wp)
+
+
 def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None,
                    arc_segments: ArcRule | None = None) -> PlannerMoves:
     """The straight moves of an emulated operation, arcs cut by ``arc_segments``.
@@ -234,18 +242,32 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows[idx], arc_segments)
 
 
-def _chords_within_limit(op, chords: np.ndarray, rows: np.ndarray, room: int) -> np.ndarray:
+def _chords_within_limit(op, chords: np.ndarray, angle: np.ndarray, rows: np.ndarray, room: int) -> np.ndarray:
     """Chord counts of the arcs, cut down when they would pass ``max_motions`` (an arc with a huge
-    radius can ask for billions); the error names the arc asking for the most."""
+    radius or a billion turns can ask for billions); the error names the arc asking for the most.
+
+    An arc whose fewer chords would each sweep more than a quarter turn (a
+    multi-turn arc: its chords would collapse to points) gets none: it keeps
+    the emulator's time, its length over its feed.
+    """
     total = float(chords.sum())
     if total <= room:
         return chords.astype(np.int64)
     worst = int(np.argmax(chords))
-    op.diagnostics.report(int(op.table.line[rows[worst]]), 1, f"arcs would be cut into {total:,.0f} moves, more than "
-                          f"max_motions={op.max_motions:,}; planned with fewer chords (this one asked for "
-                          f"{chords[worst]:,.0f}), so their times are approximate", kind="limit")
     scale = max(room, chords.size) / total
-    return np.maximum(np.floor(chords * scale), 1.0).astype(np.int64)
+    counts = np.maximum(np.floor(chords * scale), 1.0).astype(np.int64)
+    unplanned = angle / counts > np.pi / 2
+    counts[unplanned] = 0
+    coarser = "planned with fewer chords, so their times are approximate"
+    if unplanned[worst]:
+        what = f"this one (asking for {chords[worst]:,.0f}) is timed at its length over its feed"
+        what += f"; other arcs are {coarser}" if (~unplanned).any() else ""
+    else:
+        what = f"{coarser} (this one asked for {chords[worst]:,.0f})"
+        what += "; arcs of many turns are timed at their length over their feed" if unplanned.any() else ""
+    op.diagnostics.report(int(op.table.line[rows[worst]]), 1, f"arcs would be cut into {total:,.0f} moves, more than "
+                          f"max_motions={op.max_motions:,}; {what}", kind="limit")
+    return counts
 
 
 def _move_ends(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -284,7 +306,6 @@ def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc
     start = move_start[is_arc]
     end = move_end[is_arc]
     cw = np.asarray(w["motion"])[arc_idx] == 3
-    angle = np.zeros(arc_idx.size)
     radius = np.zeros(arc_idx.size)
     axes = np.zeros((arc_idx.size, 3), np.int64)
     for plane in (17, 18, 19):
@@ -293,13 +314,22 @@ def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc
             continue
         (f, g, h), _ = arcs.PLANES[plane]
         axes[sel] = (f, g, h)
-        s2, e2, c2 = start[sel][:, [f, g]], end[sel][:, [f, g]], centers[sel][:, [f, g]]
-        angle[sel] = arcs.sweep(s2, e2, c2, cw[sel], np.ones(int(sel.sum())))
-        radius[sel] = np.hypot(*(s2 - c2).T)
+        radius[sel] = np.hypot(*(start[sel][:, [f, g]] - centers[sel][:, [f, g]]).T)
     rise = end[np.arange(arc_idx.size), axes[:, 2]] - start[np.arange(arc_idx.size), axes[:, 2]]
-    travel = np.hypot(radius * angle, rise)
+    # The emulator's path length holds the whole sweep, extra turns (P) included: the angle is
+    # the unrolled arc (the length without the rise) over the radius.
+    travel = np.asarray(w["distance"], float)[arc_idx]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        angle = np.sqrt(np.maximum(travel**2 - rise**2, 0.0)) / radius
+    angle = np.where(np.isfinite(angle), angle, 0.0)
     chords = np.maximum(arc_segments(travel, angle, radius, speed[is_arc]), 1.0)
-    counts[is_arc] = _chords_within_limit(op, chords, rows[is_arc], room=op.max_motions - (idx.size - arc_idx.size))
+    counts[is_arc] = _chords_within_limit(op, chords, angle, rows[is_arc],
+                                          room=op.max_motions - (idx.size - arc_idx.size))
+    if not counts.all():  # arcs left unplanned: no moves
+        kept, kept_arcs = counts > 0, counts[is_arc] > 0
+        idx, is_arc, move_start, move_end, speed, rows, counts = (a[kept] for a in (idx, is_arc, move_start, move_end,
+                                                                                  speed, rows, counts))
+        centers, start, cw, angle, radius, axes = (a[kept_arcs] for a in (centers, start, cw, angle, radius, axes))
 
     total = int(counts.sum())
     owner = np.repeat(np.arange(idx.size), counts)
@@ -322,3 +352,28 @@ def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc
     first = np.cumsum(counts) - counts
     start_all[first] = move_start
     return PlannerMoves(start_all, end_all, speed[owner], rows[owner], idx[owner])
+
+
+def with_kept_steps(w, moves: PlannerMoves, result: PlanResult, kept: np.ndarray) -> tuple[PlannerMoves, PlanResult]:
+    """Insert the steps ``kept`` (waypoints the planner has no move for) in program order, at the emulator's time.
+
+    Such steps are rotary-only moves, moves through stored points and arcs
+    too long to cut into chords within ``max_motions``; the machine is taken
+    to be at rest around them (see :func:`follows_kept_step`).
+    """
+    k = kept.size
+    position = np.column_stack([w["x"], w["y"], w["z"], np.cumsum(w["de"])])[kept]
+    rows = w["command"][kept]
+    extra = PlannerMoves(position, position.copy(), np.asarray(w["feed"], float)[kept] / 60.0, rows, kept)
+    zero = np.zeros(k)
+    extra_result = PlanResult(zero, zero, zero, np.full(k, np.inf), zero, np.asarray(w["time"], float)[kept], zero)
+    order = np.argsort(np.r_[moves.waypoint, kept], kind="stable")
+
+    def merged(a, b):
+        return np.concatenate([a, b])[order]
+
+    moves = PlannerMoves(*(merged(getattr(moves, f), getattr(extra, f))
+                           for f in ("start", "end", "speed_v", "row", "waypoint")))
+    result = PlanResult(*(merged(getattr(result, f), getattr(extra_result, f))
+                          for f in ("start_v", "cruise_v", "end_v", "accel", "accel_t", "cruise_t", "decel_t")))
+    return moves, result

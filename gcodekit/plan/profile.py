@@ -168,7 +168,8 @@ class MotionProfile:
 
     # -- planning ------------------------------------------------------------------
 
-    def plan(self, moves: PlannerMoves, *, stops: np.ndarray | None = None) -> PlanResult:
+    def plan(self, moves: PlannerMoves, *, stops: np.ndarray | None = None,
+             length_d: np.ndarray | None = None) -> PlanResult:
         """Entry, cruise and exit speeds and phase times of each move.
 
         Parameters
@@ -180,6 +181,10 @@ class MotionProfile:
         stops : ndarray of bool, default: None
             Moves after which the machine comes to rest (dwells, tool
             changes, exact-stop mode).
+        length_d : ndarray, default: None
+            Path length of each move (mm), for moves along a curve (the
+            chords of an arc, each its share of the arc's length); None: the
+            straight distance between its ends.
 
         Returns
         -------
@@ -200,6 +205,8 @@ class MotionProfile:
         move_d = np.where(is_kinematic, move_d, np.abs(axes_d[:, 3]))
         with np.errstate(divide="ignore", invalid="ignore"):
             axes_r = np.where(is_kinematic[:, None], axes_d[:, :3] / move_d[:, None], 0.0)
+        if length_d is not None:
+            move_d = np.where(is_kinematic, np.asarray(length_d, float), move_d)
         target_v = np.asarray(moves.speed_v, float)
         if self.max_velocity is not None:
             target_v = np.minimum(target_v, self.max_velocity)

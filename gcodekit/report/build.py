@@ -22,6 +22,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..model.slicer import compare
+
 if TYPE_CHECKING:
     from ..model.operation import Operation
 
@@ -44,7 +46,11 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
     Returns
     -------
     dict with ``name``, ``summary``, ``breakdown`` (``by``, ``rows``), ``layers``
-    (per-layer rows, additive only), ``stages`` and ``toolpath`` (mill only).
+    (per-layer rows, additive only), ``slicer_rows`` (gcodekit's figures
+    beside the slicer's, :func:`gcodekit.model.slicer.compare`),
+    ``slicer_layers`` (the layers the slicer's progress marks close,
+    :func:`gcodekit.analysis.slicer_layer_times`), ``stages`` and ``toolpath``
+    (mill only).
     """
     summary = op.summary()
     additive = summary["process"] == "additive"
@@ -52,12 +58,17 @@ def report_data(op: "Operation", *, transpile: bool = True) -> dict[str, Any]:
     summary["diagnostics"] = [{**d, "elsewhere": Path(d["file"]).name if d["file"] != op.diagnostics.file else ""}
                               for d in summary["diagnostics"][:MAX_DIAGNOSTICS]]
     data: dict[str, Any] = {"name": Path(op.file).name, "summary": summary,
-                            "breakdown": breakdown(op), "layers": None, "stages": None, "toolpath": None}
+                            "breakdown": breakdown(op), "layers": None, "stages": None, "toolpath": None,
+                            "slicer_rows": compare(summary), "slicer_layers": []}
     if additive:
         by_layer = op.time_by("layer")
         by_layer = by_layer[by_layer.index >= 0]
         data["layers"] = [{"layer": int(k), "time_s": float(r.time_s), "filament_mm": float(r.filament_mm)}
                           for k, r in by_layer.iterrows()]
+        marks = op.slicer_layer_times()
+        data["slicer_layers"] = [{"layer": int(k), "layers": int(r.layers), "time_s": float(r.time_s),
+                                  "slicer_time_s": float(r.slicer_time_s), "elapsed_s": float(r.elapsed_s),
+                                  "slicer_elapsed_s": float(r.slicer_elapsed_s)} for k, r in marks.iterrows()]
     if transpile and summary["process"] == "subtractive":
         from ..transpile import Transpiler
 

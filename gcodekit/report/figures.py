@@ -177,15 +177,26 @@ def layer_thumbnails(drawing: Drawing, count: int = THUMBNAILS) -> "Figure | Non
     return fig
 
 
-def layer_times(rows: list[dict[str, Any]]) -> "Figure | None":
-    """Planned time of each layer (bars)."""
+def layer_times(rows: list[dict[str, Any]], slicer_rows: list[dict[str, Any]] = ()) -> "Figure | None":
+    """Planned time of each layer (bars) and, when the file has progress marks, the slicer's (a step line).
+
+    The slicer's time between two marks is spread evenly over the layers
+    between them (Cura marks every layer; PrusaSlicer's M73 only where its
+    minutes left change).
+    """
     if not rows:
         return None
     from matplotlib.ticker import MaxNLocator
 
     fig = _figure(2.8, left=0.08, right=0.98, bottom=0.16, top=0.9)
     ax = fig.add_subplot()
-    ax.bar([r["layer"] for r in rows], [r["time_s"] for r in rows], width=1.0, color="#3b6ea8")
+    ax.bar([r["layer"] for r in rows], [r["time_s"] for r in rows], width=1.0, color="#3b6ea8",
+           label="gcodekit (planned)")
+    if slicer_rows:
+        edges = [slicer_rows[0]["layer"] - slicer_rows[0]["layers"] + 0.5] + [r["layer"] + 0.5 for r in slicer_rows]
+        per_layer = [r["slicer_time_s"] / r["layers"] for r in slicer_rows]
+        ax.stairs(per_layer, edges, color="#d9822b", linewidth=1.2, label="slicer's marks")
+        ax.legend(fontsize=7, loc="upper right")
     ax.set_xlabel("layer")
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("time, s")
@@ -274,7 +285,7 @@ def report_figures(op: "Operation", data: dict[str, Any]) -> dict[str, str]:
         figures["iso"] = toolpath_iso(drawing)
         figures["top"] = toolpath_top(drawing)
     if data["layers"]:
-        figures["layer_times"] = layer_times(data["layers"])
+        figures["layer_times"] = layer_times(data["layers"], data.get("slicer_layers") or [])
         figures["thumbnails"] = layer_thumbnails(drawing) if drawing is not None and drawing.segments.size else None
     figures["velocity"] = velocity(op)
     figures["breakdown"] = breakdown_chart(data["breakdown"])

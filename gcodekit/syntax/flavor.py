@@ -189,6 +189,11 @@ class Flavor:
     codes : mapping of str to str
         Code such as ``"G0"`` or ``"M104"`` to normalized command
         (:data:`COMMANDS`); numbers are written without leading zeros.
+    firmware_codes : mapping of str to str
+        Codes the firmware knows that gcodekit does not model, to what each
+        does (``"M105": "report temperatures"``): kept as generic commands
+        with at most one info per code, never a warning, since the program
+        is right to use them.
     units : {"mm", "inch"}
         Units in force at program start.
     extrusion : {"absolute", "relative", ""}
@@ -233,6 +238,7 @@ class Flavor:
     required_axes: str = ""
     words: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     codes: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    firmware_codes: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     units: str = "mm"
     extrusion: str = ""
     rapid_is_feed: bool = False

@@ -4,9 +4,9 @@ Validation is strict, like Klipper's config: an unknown key, a wrong type or
 a value outside the vocabulary raises :class:`~gcodekit.errors.ConfigError`
 naming the file, the table and the key, with a did-you-mean when a close
 spelling exists.  A file may start from another with ``inherit = "name"``:
-scalars and lists replace the parent's, the ``[words]``, ``[codes]`` and
-``[detect]`` tables merge key by key, and a word or code mapped to ``""``
-is removed.
+scalars and lists replace the parent's, the ``[words]``, ``[codes]``,
+``[firmware_codes]`` and ``[detect]`` tables merge key by key, and a word or
+code mapped to ``""`` is removed.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from .flavor import BLOCK_SPLITS, COMMANDS, PARAMETERS, DetectRules, Flavor
 FLAVOR_DIR = Path(__file__).with_name("flavors")
 
 #: Tables of a flavor file; every other key is a top-level value.
-_TABLES = ("words", "codes", "detect")
+_TABLES = ("words", "codes", "firmware_codes", "detect")
 #: Keys that are not Flavor fields.
 _EXTRA_KEYS = ("inherit",)
 #: Codes are written as in the program but normalized: upper case, no
@@ -182,6 +182,10 @@ def _check(raw: dict[str, Any], path: Path) -> None:
             raise ConfigError(
                 f"{where}: {param!r} is not a parameter name{did_you_mean(str(param), PARAMETERS)}"
             )
+    for code, what in raw.get("firmware_codes", {}).items():
+        _check_code(code, _where(path, "firmware_codes", code))
+        if not isinstance(what, str):
+            raise ConfigError(f"{_where(path, 'firmware_codes', code)}: expected a string saying what the code does")
     for code, command in raw.get("codes", {}).items():
         _check_code(code, _where(path, "codes", code))
         if command != "" and command not in COMMANDS:
@@ -243,6 +247,7 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
         raise ConfigError(f"{path}: name: missing required key")
     words = {k: v for k, v in data.get("words", {}).items() if v}
     codes = {k: v for k, v in data.get("codes", {}).items() if v}
+    firmware_codes = {k: v for k, v in data.get("firmware_codes", {}).items() if v and k not in codes}
     detect = dict(data.get("detect", {}))
 
     def get(key: str) -> Any:
@@ -301,5 +306,6 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
         **values,
         words=MappingProxyType(words),
         codes=MappingProxyType(codes),
+        firmware_codes=MappingProxyType(firmware_codes),
         detect=DetectRules(**rules),
     )

@@ -13,6 +13,8 @@ import os
 import re
 from pathlib import Path
 
+from ..limits import MAX_ITERATIONS, MAX_MOTIONS
+
 _MARKDOWN_PUNCTUATION = re.compile(r"([\\`*_{}\[\]()#+\-.!|~])")
 
 
@@ -22,11 +24,13 @@ def markdown_text(text: str) -> str:
 
 
 def exploration_notebook(program: str | os.PathLike, *, machine: str | None = None,
-                         machine_config: str | os.PathLike | None = None, relative_to: str | os.PathLike = "."):
+                         machine_config: str | os.PathLike | None = None, relative_to: str | os.PathLike = ".",
+                         max_motions: int = MAX_MOTIONS, max_iterations: int = MAX_ITERATIONS):
     """The notebook (an ``nbformat`` node) exploring ``program``.
 
     The program is named relative to ``relative_to`` (the notebook's folder)
-    when it lies below it, else by its absolute path.
+    when it lies below it, else by its absolute path; the notebook reads it
+    under ``max_motions`` and ``max_iterations`` (see :mod:`gcodekit.limits`).
     """
     from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 
@@ -43,10 +47,12 @@ def exploration_notebook(program: str | os.PathLike, *, machine: str | None = No
         new_markdown_cell(f"# {markdown_text(name)}\n\nWritten by `gcodekit notebook`: the program read and "
                           "emulated, its tables and the widgets wired to it. Run all cells (a kernel with `gcodekit[widgets]`)."),
         # repr() writes the values as Python literals: a file name cannot become code
-        new_code_cell(f"program = {where(program)!r}\nmachine = {machine!r}\nmachine_config = {config!r}",
+        new_code_cell(f"program = {where(program)!r}\nmachine = {machine!r}\nmachine_config = {config!r}\n"
+                      f"max_motions = {int(max_motions)!r}\nmax_iterations = {int(max_iterations)!r}",
                       metadata={"tags": ["parameters"]}),
         new_code_cell("import gcodekit\nfrom gcodekit.widgets import LayerViewer, StageDiff, VelocityPlot\n\n"
-                      "op = gcodekit.gcode_to_operation(program, machine, machine_config=machine_config)\n"
+                      "op = gcodekit.gcode_to_operation(program, machine, machine_config=machine_config,\n"
+                      "                                 max_motions=max_motions, max_iterations=max_iterations)\n"
                       "stats = op.get_statistics()\n"
                       "{k: stats[k] for k in (\"lines\", \"moves\", \"distance_mm\", \"time_s\", \"layers\", \"filament_mm\", "
                       "\"bounds\")}"),
@@ -72,7 +78,8 @@ def exploration_notebook(program: str | os.PathLike, *, machine: str | None = No
 
 def write_exploration_notebook(program: str | os.PathLike, out: str | os.PathLike, *, machine: str | None = None,
                                machine_config: str | os.PathLike | None = None, execute: bool = False,
-                               html: bool = False) -> Path:
+                               html: bool = False, max_motions: int = MAX_MOTIONS,
+                               max_iterations: int = MAX_ITERATIONS) -> Path:
     """Write :func:`exploration_notebook` to ``out``; ``execute`` runs it, ``html`` also writes
     ``out`` with ``.html`` that shows its pictures offline (implies ``execute``)."""
     import nbformat
@@ -80,7 +87,8 @@ def write_exploration_notebook(program: str | os.PathLike, out: str | os.PathLik
     out = Path(out)
     if not Path(program).is_file():
         raise FileNotFoundError(f"no such program file: {os.fspath(program)!r}")
-    nb = exploration_notebook(program, machine=machine, machine_config=machine_config, relative_to=out.parent)
+    nb = exploration_notebook(program, machine=machine, machine_config=machine_config, relative_to=out.parent,
+                              max_motions=max_motions, max_iterations=max_iterations)
     if execute or html:
         from .export import execute as run, write_offline_html
 

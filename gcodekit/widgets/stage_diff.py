@@ -166,8 +166,10 @@ class StageDiff(PictureDisplay):
         self._refresh()
 
     def _refresh(self, change=None) -> None:
-        self.table.value = self.diff_html()
+        # the picture first: the browser gets updates in order, so a table that shows the new pair
+        # means the picture of that pair has arrived too
         self.image.value = to_png(self.figure())
+        self.table.value = self.diff_html()
 
     def sides(self) -> tuple[Side, Side]:
         """The two texts compared."""

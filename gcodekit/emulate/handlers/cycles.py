@@ -10,6 +10,9 @@ from ..threading import ThreadingError, check_words, threading_moves
 from .registry import CANNED_CYCLE, SYNCHRONIZED, Block, Context, Outcome, Waypoint, handles
 from .words import move_to, program_target
 
+#: What a spindle-synchronized move at no speed does (rs274 accepts it; the machine waits forever).
+STALLS = ": the tool waits on the spindle and the move never ends (a controller stalls); its time is unknown"
+
 #: Canned cycles rs274 refuses with the spindle stopped (with its spelling of each code)
 _SPINDLE_CYCLES = {"cycle_tap_left": "G74", "cycle_tap": "G84", "cycle_bore_stop": "g86", "cycle_back_bore": "g87",
                    "cycle_bore_manual": "g88"}
@@ -74,6 +77,12 @@ def threading_cycle(ctx: Context, block: Block) -> Outcome | None:
     except ThreadingError as exc:
         ctx.error(block.line, str(exc))
         return None
+    if ctx.rs274_blocks and (s.spindle == 0 or s.speed <= 0):
+        ctx.error(block.line, "Chosen spindle (0) not turning in G76")
+        return None
+    if s.spindle == 0 or s.speed <= 0 or params["P"] == 0:
+        ctx.diagnostics.warn(block.line, 1, ("G76 with a pitch of P0" if params["P"] == 0 else
+                                             "G76 with the spindle stopped") + STALLS)
     k = s.units
     halve = 2.0 if s.diameter else 1.0  # I, J and K are diameters in G7 (X words are already radii)
     program = s.program_position()
@@ -125,4 +134,6 @@ def _synchronized_rate(ctx: Context, block: Block, code: str) -> float | None:
     if problem:
         ctx.error(block.line, problem)
         return None
+    if params["K"] == 0:  # rs274 accepts it
+        ctx.diagnostics.warn(block.line, 1, f"{code} with a pitch of K0" + STALLS)
     return params["K"] * s.scale()[2] * s.speed
