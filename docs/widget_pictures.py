@@ -21,7 +21,7 @@ CELLS = [
     "op = gcodekit.gcode_to_operation('examples/cube20_prusaslicer_marlin.gcode')\n"
     "viewer = LayerViewer(op, color_by='feature')\nviewer.layers.value = (0, 62)\nviewer.moves.value = 40\nviewer",
     "VelocityPlot(op, layers=(30, 30))",
-    "StageDiff('notebooks/worksheets/programs/comp.ngc', a=0, b=6, tool_table='notebooks/worksheets/programs/tools.tbl')",
+    "StageDiff('notebooks/worksheets/programs/pocket_wall.ngc', a=0, b=6, frame='machine', tool_table='notebooks/worksheets/programs/tools.tbl')",
 ]
 NAMES = ["layer_viewer", "velocity_plot", "stage_diff"]
 

@@ -73,3 +73,9 @@ if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$want" ]; then
   "$VENV/bin/python" -m pip install -q -e "$ROOT[test]" || die "pip could not install gcodekit (is the package index reachable?)"
   echo "$want" > "$STAMP"
 fi
+
+# An editable install leaves out data files: put gcodekit's Jupyter settings where its wheel puts them, so
+# plain `jupyter nbconvert --to html` and JupyterLab's HTML export show the widgets' pictures offline here too.
+mkdir -p "$VENV/etc/jupyter/jupyter_server_config.d"
+cp "$ROOT/jupyter-config/jupyter_nbconvert_config.json" "$VENV/etc/jupyter/"
+cp "$ROOT/jupyter-config/jupyter_server_config.d/gcodekit.json" "$VENV/etc/jupyter/jupyter_server_config.d/"

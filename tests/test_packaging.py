@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -93,6 +94,39 @@ def test_notebook_command_runs_from_the_wheel(installed, tmp_path):
                           cwd=tmp_path, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert "LayerViewer(op)" in (tmp_path / "cube.ipynb").read_text()
+
+
+def test_plain_nbconvert_shows_widget_pictures_where_the_wheel_is_installed(installed, tmp_path):
+    """The wheel's etc/jupyter config registers gcodekit's preprocessor: no widget view, no remote script."""
+    import base64
+
+    import nbformat
+    from nbformat.v4 import new_code_cell, new_notebook, new_output
+
+    python, _, wheel = installed
+    names = zipfile.ZipFile(wheel).namelist()
+    assert any(n.endswith(".data/data/etc/jupyter/jupyter_nbconvert_config.json") for n in names)
+    assert any(n.endswith(".data/data/etc/jupyter/jupyter_server_config.d/gcodekit.json") for n in names)
+    from gcodekit.widgets.picture import message_figure, to_png
+
+    png = to_png(message_figure("a widget's picture"))
+    view = {"version_major": 2, "version_minor": 0, "model_id": "m1"}
+    output = new_output("display_data", {"application/vnd.jupyter.widget-view+json": view,
+                                         "image/png": base64.b64encode(png).decode(), "text/plain": "<LayerViewer>"})
+    nb = new_notebook(cells=[new_code_cell("LayerViewer(op)", outputs=[output], execution_count=1)])
+    state = {"m1": {"model_name": "VBoxModel", "model_module": "@jupyter-widgets/controls",
+                    "model_module_version": "2.0.0", "state": {}}}
+    nb.metadata["widgets"] = {"application/vnd.jupyter.widget-state+json": {"version_major": 2, "version_minor": 0,
+                                                                           "state": state}}
+    nbformat.write(nb, tmp_path / "handin.ipynb")
+    done = subprocess.run([str(python), "-m", "nbconvert", "--to", "html", "handin.ipynb"], cwd=tmp_path,
+                          capture_output=True, text=True,
+                          # nbconvert's templates are data of the borrowed environment; its config is the wheel's
+                          env={**os.environ, "PYTHONNOUSERSITE": "1", "JUPYTER_PATH": f"{sys.prefix}/share/jupyter"})
+    assert done.returncode == 0, done.stderr
+    page = (tmp_path / "handin.html").read_text()
+    assert page.count('src="data:image/png;base64,') == 1
+    assert "widget-view+json" not in page and not re.search(r"<script[^>]*\ssrc=\"https?:", page)
 
 
 def test_freecad_path_api_runs_from_the_wheel(installed, tmp_path):

@@ -248,7 +248,7 @@ def test_velocity_over_distance(cube):
 
 @pytest.fixture(scope="module")
 def comp_diff():
-    return StageDiff(PROGRAMS / "comp.ngc", a=0, b=6, tool_table=PROGRAMS / "tools.tbl")
+    return StageDiff(PROGRAMS / "pocket_wall.ngc", a=0, b=6, tool_table=PROGRAMS / "tools.tbl")
 
 
 def test_stages_line_up_by_source_line(comp_diff):
@@ -261,16 +261,36 @@ def test_stages_line_up_by_source_line(comp_diff):
     assert 'class="changed"' in html and "G1 X40" in html and "G10 L2 P1 X50 Y20 Z0" in html
 
 
+def _feed_box(diff, index):
+    """(xmin, ymin, xmax, ymax) of a side's feed moves at cutting depth, as the picture draws them."""
+    op, shift, _ = diff._operation(diff.sides()[index], index)
+    xyz = np.column_stack([op.waypoints[k] for k in "xyz"]) - (0 if shift is None else shift)
+    cut = xyz[(np.asarray(op.waypoints["motion"]) == 2) & (xyz[:, 2] < 0)]
+    return (*cut[:, :2].min(axis=0), *cut[:, :2].max(axis=0))
+
+
 def test_stages_are_drawn_as_written(comp_diff):
-    written = comp_diff._operation(comp_diff.sides()[0], 0)
-    machine = comp_diff._operation(comp_diff.sides()[1], 1)
-    feed = lambda op: op.waypoints["x"][op.waypoints["motion"] == 2]  # noqa: E731
-    assert feed(written).max() == pytest.approx(40.0)  # program coordinates, programmed path
-    assert feed(machine).max() == pytest.approx(50 + 40 - 3)  # G54 origin X50, 3 mm tool radius inside
+    # the 40 x 20 pocket wall: G54 origin at machine X50 Y20, the 6 mm tool's centre 3 mm inside (by hand)
+    assert _feed_box(comp_diff, 0) == pytest.approx((0, 0, 40, 20))  # program coordinates, programmed path
+    assert _feed_box(comp_diff, 1) == pytest.approx((53, 23, 87, 37))  # machine coordinates, compensated
     comp_diff.stage_a.value = 6
     assert "0 changed, 0 only left, 0 only right" in comp_diff.diff_html()
     assert bytes(comp_diff.image.value).startswith(b"\x89PNG")
     comp_diff.stage_a.value = 0
+
+
+@pytest.mark.parametrize("frame, programmed, compensated", [
+    ("machine", (50, 20, 90, 40), (53, 23, 87, 37)),
+    ("program", (0, 0, 40, 20), (3, 3, 37, 17)),
+])
+def test_both_stages_in_one_frame(frame, programmed, compensated):
+    diff = StageDiff(PROGRAMS / "pocket_wall.ngc", a=0, b=6, frame=frame, tool_table=PROGRAMS / "tools.tbl")
+    assert _feed_box(diff, 0) == pytest.approx(programmed)
+    assert _feed_box(diff, 1) == pytest.approx(compensated)  # 3 mm inside on every side, in the same frame
+    legend = " ".join(t.get_text() for t in diff.figure().axes[0].get_legend().get_texts())
+    assert legend.count(f"({frame} coordinates") == 2
+    with pytest.raises(ValueError, match="frame must be one of"):
+        StageDiff(PROGRAMS / "pocket_wall.ngc", frame="work")
 
 
 def test_two_programs(tmp_path):
@@ -313,3 +333,8 @@ def test_checks():
     assert check("Planned", "planned").ok is True
     assert check(None, 1.0).ok is None
     assert "Hint: add" in check(3, 4, hint="add").message
+    # a wrong answer says which part is off and which way, never the expected value
+    wrong = check((110, 50, 25), (110.0, 50.0, 24.0), names=("x", "y", "z"))
+    assert wrong.message == "Not quite: z is too large (x and y are right)." and "24" not in wrong.message
+    assert "4" not in check(3, 4).message.replace("3", "") and "too small" in check(3, 4).message
+    assert "climb" not in check("conventional", "climb").message

@@ -2,11 +2,15 @@
 
 Every output line of a stage starts with the N-number of the source line it
 came from, so two stages line up by source line: the table pairs them, marks
-what changed and shows the source line each pair came from.  The picture
-draws both stages' toolpaths as their words say, in the frame each stage is
-written in: a stage that still carries work offsets or cutter compensation
-is drawn without them (program coordinates, the programmed path), a later
-stage in machine coordinates with the compensated path.
+what changed and shows the source line each pair came from.  By default the
+picture draws both stages' toolpaths as their words say, in the frame each
+stage is written in: a stage that still carries work offsets or cutter
+compensation is drawn without them (program coordinates, the programmed
+path), a later stage in machine coordinates with the compensated path.
+``frame="machine"`` or ``frame="program"`` draws both in one frame instead,
+so the programmed and the compensated path can be compared: a stage written
+in program coordinates is drawn with its offsets applied, or a stage in
+machine coordinates moved back by the offsets in force at each source line.
 """
 
 from __future__ import annotations
@@ -29,6 +33,10 @@ _N_WORD = re.compile(r"^N(\d+)\s")
 _N_IN_COMMENT = re.compile(r"^\((?:dropped: )?N(\d+)\s")
 #: Codes whose effect a stage still carries in words: left out when drawing the stage "as written".
 _FRAME_CODES = re.compile(r"^N\d+\s+(G5[4-9](\.\d)?|G92(\.\d)?|G10|G43(\.\d)?|G49|G52|G4[0-2](\.\d)?)\b")
+#: Cutter compensation codes: left out when drawing a stage's programmed path in machine coordinates.
+_COMP_CODES = re.compile(r"^N\d+\s+G4[0-2](\.\d)?\b")
+#: The frames both stages can be drawn in (None: each in its own).
+FRAMES = (None, "machine", "program")
 #: (feed, rapid) line colour and style of the left and the right side
 STYLES = ((("#1f77b4", "-"), ("#1f77b4", "--")), (("#ff7f0e", "-"), ("#ff7f0e", "--")))
 
@@ -83,6 +91,9 @@ class StageDiff(PictureDisplay):
     program : path, program text or Operation
     a, b : int, default: 0 and 6
         The stages compared (see :data:`gcodekit.transpile.STAGE_NAMES`).
+    frame : {None, "machine", "program"}, default: None
+        Draw both stages in machine or in program coordinates; None draws
+        each in the frame it is written in.
     machine : str, default: None
     **options
         As for :func:`gcodekit.gcode_to_operation` (``tool_table="tools.tbl"`` for cutter compensation).
@@ -103,9 +114,13 @@ class StageDiff(PictureDisplay):
         StageDiff.programs("part_v1.ngc", "part_v2.ngc")
     """
 
-    def __init__(self, program, a: int = 0, b: int = 6, *, machine: str | None = None, **options):
+    def __init__(self, program, a: int = 0, b: int = 6, *, frame: str | None = None, machine: str | None = None,
+                 **options):
         from ..transpile import STAGE_NAMES
 
+        if frame not in FRAMES:
+            raise ValueError(f"frame must be one of {FRAMES}, not {frame!r}")
+        self.frame = frame
         self.error: str | None = None
         self.transpiler = None
         self._stages: dict[int, Side] = {}
@@ -133,6 +148,7 @@ class StageDiff(PictureDisplay):
     def programs(cls, a_path, b_path, *, machine: str | None = None, **options) -> "StageDiff":
         """Compare two programs line by line (a part before and after an edit), their toolpaths overlaid."""
         self = cls.__new__(cls)
+        self.frame = None
         self.error, self.transpiler, self._stages, self._ops, self._options = None, None, {}, {}, options
         self.name = f"{Path(a_path).name} / {Path(b_path).name}"
         sides = []
@@ -250,15 +266,53 @@ class StageDiff(PictureDisplay):
     # -- the picture ----------------------------------------------------------------------
 
     def _operation(self, side: Side, index: int):
-        """The toolpath of one side: a stage's text as written (see the module), or a program."""
+        """The toolpath of one side and the frame it is drawn in: a stage's text (see the module), or a program.
+
+        Returns the operation, the (n, 3) shift to take off each waypoint (None for none) and the frame's name.
+        """
         if self._programs is not None:
-            return self._ops.get(side.name)
-        key = self.stage_a.value if index == 0 else self.stage_b.value
+            return self._ops.get(side.name), None, side.frame
+        key = (self.stage_a.value if index == 0 else self.stage_b.value, self.frame)
         if key not in self._ops:
-            text = "\n".join(line for line in side.lines if not _FRAME_CODES.match(line)) + "\n"
-            machine = self.transpiler.op.machine
-            self._ops[key] = _emulate(text, machine.name if machine is not None else None, self._options)
+            in_machine = side.frame.startswith("machine")
+            if self.frame == "machine" and not in_machine:  # offsets applied, the programmed path
+                op, _ = self._emulate_lines(side.lines, _COMP_CODES)
+                self._ops[key] = op, None, "machine coordinates, programmed path"
+            elif self.frame == "program" and in_machine:  # moved back by the offsets of each source line
+                op, kept = self._emulate_lines(side.lines, _FRAME_CODES)
+                self._ops[key] = op, self._shift(op, kept), side.frame.replace("machine", "program")
+            else:
+                self._ops[key] = self._emulate_lines(side.lines, _FRAME_CODES)[0], None, side.frame
         return self._ops[key]
+
+    def _emulate_lines(self, lines: list[str], leave_out: re.Pattern):
+        """The operation of ``lines`` without those ``leave_out`` matches, and the lines kept."""
+        kept = [line for line in lines if not leave_out.match(line)]
+        machine = self.transpiler.op.machine
+        return _emulate("\n".join(kept) + "\n", machine.name if machine is not None else None, self._options), kept
+
+    def _offsets(self) -> dict[int, np.ndarray]:
+        """Machine minus program position after each source line of stage 0 (its offsets in force)."""
+        if "offsets" not in self._ops:
+            lines = self._stage(0).lines or []
+            ends = []
+            for leave_out in (_COMP_CODES, _FRAME_CODES):
+                ends.append(_ends_by_source(*self._emulate_lines(lines, leave_out)))
+            machine, program = ends
+            self._ops["offsets"] = {n: machine[n] - program[n] for n in machine if n in program}
+        return self._ops["offsets"]
+
+    def _shift(self, op, lines: list[str]) -> np.ndarray:
+        """Per waypoint of ``op`` (emulated from ``lines``), the offsets in force at its source line."""
+        offsets = self._offsets()
+        numbers = _source_numbers(op, lines)
+        shift = np.zeros((numbers.size, 3))
+        known = sorted(offsets)
+        for row, n in enumerate(numbers):
+            earlier = [k for k in known if k <= n] if n >= 0 else []
+            if earlier:
+                shift[row] = offsets[earlier[-1]]
+        return shift
 
     def figure(self, size: tuple[int, int] = (800, 560)):
         """Both toolpaths from above: feed moves solid, rapids dashed, each named with its frame."""
@@ -275,7 +329,7 @@ class StageDiff(PictureDisplay):
         handles = []
         for index, side in enumerate(sides):
             try:
-                op = self._operation(side, index)
+                op, shift, frame = self._operation(side, index)
             except Exception as exc:
                 return message_figure(f"{side.name}: cannot draw its toolpath: {friendly(exc)}")
             w = op.waypoints
@@ -285,6 +339,8 @@ class StageDiff(PictureDisplay):
             rows = np.flatnonzero(op.moving)
             rows = rows[rows > 0]  # a move runs from the waypoint before it
             start, end, move_of = move_segments(w, rows)
+            if shift is not None:
+                start, end = start - shift[rows][move_of], end - shift[rows][move_of]
             rapid = motion[rows][move_of] == 1
             # the left stage wide and pale under the right one: where both agree, both stay visible
             width = 3.5 if index == 0 else 1.3
@@ -292,7 +348,7 @@ class StageDiff(PictureDisplay):
                 segs = np.stack([start[mask][:, :2], end[mask][:, :2]], axis=1)
                 ax.add_collection(LineCollection(segs, colors=color, linestyles=style, alpha=0.45 if index == 0 else 0.9,
                                                  linewidths=width if what == "feed" else width / 2))
-                label = f"{side.name} ({side.frame})" if what == "feed" else f"{side.name}: rapids"
+                label = f"{side.name} ({frame})" if what == "feed" else f"{side.name}: rapids"
                 handles.append(ax.plot([], [], color=color, linestyle=style, linewidth=width, label=label)[0])
         ax.autoscale()
         ax.set_aspect("equal", adjustable="datalim")
@@ -326,6 +382,19 @@ def _frame(header: str) -> str:
     if "machine coordinates" in header:
         return "machine coordinates, programmed path"
     return "program coordinates, programmed path"
+
+
+def _source_numbers(op, lines: list[str]) -> np.ndarray:
+    """The source line (N-number) of each waypoint of ``op``, emulated from ``lines``; -1 where none."""
+    numbers = np.array([key[1] if key[0] == "N" else -1 for key in map(source_key, lines)] + [-1])
+    text_line = np.asarray(op.table.line, np.int64)[op.waypoints["command"]] - 1
+    return numbers[np.clip(text_line, 0, len(lines))]
+
+
+def _ends_by_source(op, lines: list[str]) -> dict[int, np.ndarray]:
+    """Where the tool is after each source line (the last waypoint carrying its N-number)."""
+    xyz = np.column_stack([np.asarray(op.waypoints[k], float) for k in "xyz"])
+    return {int(n): xyz[row] for row, n in enumerate(_source_numbers(op, lines)) if n >= 0}
 
 
 def _emulate(source, machine: str | None, options: dict):

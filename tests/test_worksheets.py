@@ -1,0 +1,496 @@
+"""The worksheets in notebooks/worksheets/: the curriculum a course adopts.
+
+- every exercise's answer worked out by hand here and accepted by its check; wrong answers refused with
+  feedback that never holds the expected value;
+- every write-the-G-code exercise: the teacher's program passes, the starting program and three plausible
+  wrong programs fail with feedback naming what is wrong;
+- nbgrader's own commands (generate_assignment, autograde, generate_feedback, through its Python API) on the
+  source worksheets in a course directory: the teacher's answers score full marks, the released worksheet
+  (answers left empty) and a hand-in of wrong answers score zero, and every notebook runs to its end;
+- the facts the worksheets state about their programs (line numbers, what a line says).
+
+The checks run in this process (each worksheet's code cells executed once, without a kernel); the notebooks
+run in kernels only under nbgrader (tests/test_notebooks.py converts the autograded ones to HTML).
+"""
+
+from __future__ import annotations
+
+import ast
+import contextlib
+import io
+import math
+import os
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("nbgrader")
+
+import nbformat  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+WORKSHEETS = ROOT / "notebooks" / "worksheets"
+NAMES = sorted(p.stem for p in WORKSHEETS.glob("[0-9][0-9]-*.ipynb"))
+_WIDGET_CELL = re.compile(r"^(LayerViewer|VelocityPlot|StageDiff)\(|\.view\(|^diff$")
+
+#: Answers worked out by hand from each exercise's text, independent of the notebooks' solution cells.
+HAND = {
+    "01-modal-state-units-offsets": {
+        1: (100 + 10, 50, -1 + 25),  # G54 origin X100 Y50; tip at Z-1, the reference point 25 mm above it
+        2: (100 + 30, 50 + 5),  # X10, then steps X10 Y5 and X10
+        3: 100 + 25.4,  # G20 G1 X1 in G90: 25.4 mm from the G54 origin
+    },
+    "02-arcs-planes-helices": {1: math.hypot(2 * math.pi * 10, 2)},
+    "03-tools-and-length-offsets": {1: -2 + 25 - 40},  # reference point at -2 + 25, tip 40 below it
+    "04-canned-cycles": {1: 4},  # pecks to R2-3=-1, -4, -7, -10
+    "05-feeds-and-speeds": {1: 1000 * 150 / (math.pi * 6), 3: 6 * 2 * 640 / 1000},
+    "06-cutter-compensation-and-stages": {1: 50 + 40 - 3, 3: "climb"},
+    "07-planned-against-naive-time": {
+        1: 2 * 100 / 3000 + (100 - 100**2 / 3000) / 100,  # two ramps of v/a, the rest at 100 mm/s
+        2: (100 + 2 + 100 + 2 + 100 + 6 * math.sqrt(0.5) + 26 + 103) / (2500 / 60),
+        3: 5.0,  # Klipper's square_corner_velocity at a 90-degree corner
+    },
+    "08-extrusion-retraction-temperatures": {1: 0.45 * 0.2 * 50 / (math.pi * 1.75**2 / 4), 3: 12 / (0.45 * 0.2)},
+    "09-beads-layers-heat-and-5-axis": {
+        1: 0.45 * 0.2 / ((0.45 - 0.2) * 0.2 + math.pi * 0.2**2 / 4),
+        3: (math.sin(math.radians(30)), 0.0, math.cos(math.radians(30))),
+    },
+}
+
+#: Plausible wrong answers to the numeric exercises: a step left out or a unit confused.
+WRONG = {
+    "01-modal-state-units-offsets": {1: (110, 50, -1), 2: (120, 55), 3: 25.4},
+    "02-arcs-planes-helices": {1: 2 * math.pi * 10},
+    "03-tools-and-length-offsets": {1: -2},
+    "04-canned-cycles": {1: 3},
+    "05-feeds-and-speeds": {1: 150 / (math.pi * 6), 3: 6 * 2 * 640},
+    "06-cutter-compensation-and-stages": {1: 90, 3: "conventional"},
+    "07-planned-against-naive-time": {1: 1.0, 2: 437.24 / 2500, 3: 100.0},
+    "08-extrusion-retraction-temperatures": {1: 0.45 * 0.2 * 50 / (math.pi * 1.75**2), 3: 12 * 0.45 * 0.2},
+    "09-beads-layers-heat-and-5-axis": {1: 1.0, 3: (0.0, 0.5, math.cos(math.radians(30)))},
+}
+
+
+def _program(name: str, k: int) -> str:
+    """The teacher's program of exercise ``k`` (from the solution cell of the source worksheet)."""
+    return _namespace(name)[f"program_{k}"]
+
+
+def _edit(name: str, k: int, old: str, new: str) -> str:
+    text = _program(name, k)
+    assert old in text, (name, k, old)
+    return text.replace(old, new, 1)
+
+
+#: For each write-the-G-code exercise, three plausible wrong programs (made by editing the teacher's) and what
+#: the feedback must name for each.
+WRONG_PROGRAMS = {
+    ("01-modal-state-units-offsets", 4): [
+        (lambda: _edit("01-modal-state-units-offsets", 4, " G80", ""), "missing before the first move: G80"),
+        (lambda: _edit("01-modal-state-units-offsets", 4, "S8000 M3\nG0 X10 Y10 Z5\nG1 Z-1 F200\n",
+                       "G0 X10 Y10 Z5\nG1 Z-1 F200\nS8000 M3\n"), "line 4 feeds with the spindle stopped"),
+        (lambda: _edit("01-modal-state-units-offsets", 4, "G1 Z-1 F200\nG1 X30", "G0 Z-1\nG1 X30 F200"),
+         "moves at rapid speed down to Z-1"),
+    ],
+    ("02-arcs-planes-helices", 2): [
+        (lambda: _edit("02-arcs-planes-helices", 2, "I15 J0", "R15"), "the controller would stop at an error"),
+        (lambda: _edit("02-arcs-planes-helices", 2, "I15 J0", "I-15 J0"), "the cut at Z-1 leaves the circle"),
+        (lambda: _edit("02-arcs-planes-helices", 2, "G2 X25", "G3 X25"), "degrees counter-clockwise"),
+    ],
+    ("02-arcs-planes-helices", 3): [
+        (lambda: _edit("02-arcs-planes-helices", 3, " Z-3 P3", " P3"), "no arc goes down"),
+        (lambda: _edit("02-arcs-planes-helices", 3, "G3 X5", "G2 X5"), "it turns the other way"),
+        (lambda: _edit("02-arcs-planes-helices", 3, "P3", "P2"), "it makes 2 turns"),
+    ],
+    ("03-tools-and-length-offsets", 2): [
+        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H2", "G43 H1"), "tool 2's tip goes deeper than Z-2"),
+        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H2", "G49"), "tool 2's tip goes deeper than Z-2"),
+        (lambda: _edit("03-tools-and-length-offsets", 2, "G43 H1", "G43 H2"), "tool 1's tip goes not as deep as Z-2"),
+    ],
+    ("04-canned-cycles", 2): [
+        (lambda: _edit("04-canned-cycles", 2, "G98 X30", "X30"), "the tool passes over it at Z1"),
+        (lambda: _edit("04-canned-cycles", 2, "Z-5 R1", "Z-4 R1"), "goes down to Z-4"),
+        (lambda: _edit("04-canned-cycles", 2, "X10\nG80", "G80"), "no hole at X10 Y30"),
+    ],
+    ("05-feeds-and-speeds", 2): [
+        (lambda: _edit("05-feeds-and-speeds", 2, "S7960", "S796"), "rpm: too slow for this cutter"),
+        (lambda: _edit("05-feeds-and-speeds", 2, "F637", "F318"), "the chip load is too thin"),  # one flute
+        (lambda: _edit("05-feeds-and-speeds", 2, "F637", "F1274"), "the chip load is too thick"),  # four flutes
+    ],
+    ("06-cutter-compensation-and-stages", 2): [
+        (lambda: _edit("06-cutter-compensation-and-stages", 2, "G41 D1", "G42 D1"),
+         "the tool centre leaves the box on line 9"),  # the entry move: G42 keeps the tool outside the wall
+        (lambda: _edit("06-cutter-compensation-and-stages", 2, "G40 G1 X20 Y10", "G40 G1 X-10 Y-10"),
+         "the tool centre leaves the box on line 15"),  # the exit move runs out through the wall
+        (lambda: _edit("06-cutter-compensation-and-stages", 2, "G0 X20 Y10 Z5", "G0 X-10 Y-10 Z5"),
+         "the tool centre leaves the box on line 8"),  # the plunge outside
+    ],
+    ("07-planned-against-naive-time", 4): [
+        (lambda: _program("07-planned-against-naive-time", 4).replace("F9000", "F6000"), "it takes"),
+        (lambda: _program("07-planned-against-naive-time", 4).replace("F9000", "F20000"), "asks for F20000"),
+        (lambda: re.sub(r"G1 X10[0-3](\.5)? Y4(\.5)?\n", "", _program("07-planned-against-naive-time", 4)),
+         "the path no longer passes X100.5 Y4.5"),
+    ],
+    ("08-extrusion-retraction-temperatures", 2): [
+        (lambda: _edit("08-extrusion-retraction-temperatures", 2, "M83", "M82\nG92 E0"),
+         "M83 does not come before the first E word"),
+        (lambda: _edit("08-extrusion-retraction-temperatures", 2, "G1 E-0.8 F2400\n", ""), "pulled back 0 mm"),
+        # E from the filament's diameter taken as its radius: a quarter of the plastic
+        (lambda: _program("08-extrusion-retraction-temperatures", 2).replace("E1.8709", "E0.4677"), "too little"),
+    ],
+    ("09-beads-layers-heat-and-5-axis", 2): [
+        (lambda: _program("09-beads-layers-heat-and-5-axis", 2).replace("G4 S18\n", ""), "layer 0 takes"),
+        (lambda: _program("09-beads-layers-heat-and-5-axis", 2).replace("G4 S18\n", "").replace("F3000", "F300"),
+         "prints at F300"),
+        (lambda: _program("09-beads-layers-heat-and-5-axis", 2).replace("G4 S18", "G4 S8"), "layer 0 takes"),
+    ],
+}
+
+#: Stated facts: (worksheet, program file, line number, text that line holds).
+STATED_LINES = [
+    ("01", "controller.ngc", 3, "G10 L2 P1 X100 Y50 Z0"), ("01", "controller.ngc", 6, "G43 H1"),
+    ("01", "controller.ngc", 9, "G1 Z-1"), ("01", "controller.ngc", 10, "G1 X10"), ("01", "controller.ngc", 11, "G91"),
+    ("01", "controller.ngc", 16, "G1 X1"),
+    ("03", "two_tools.ngc", 11, "G43 H1"), ("03", "two_tools.ngc", 14, "G1 Z-2"),
+    ("04", "drill.ngc", 5, "G99 G83 X0 Y0 Z-10 R2 Q3"),
+    *[("07", "zigzag.gcode", n, "G1 X10") for n in range(10, 16)],
+]
+
+
+# -- running a worksheet's code in this process ------------------------------------------------------------------
+
+_NAMESPACES: dict[str, dict] = {}
+
+
+def _cells(name: str):
+    return nbformat.read(WORKSHEETS / f"{name}.ipynb", as_version=4).cells
+
+
+def _namespace(name: str) -> dict:
+    """The worksheet's code cells run once in order (widget cells left out), with the teacher's answers."""
+    if name not in _NAMESPACES:
+        namespace: dict = {}
+        with _in(WORKSHEETS), contextlib.redirect_stderr(io.StringIO()):
+            for cell in _cells(name):
+                if cell.cell_type == "code":
+                    body = ast.parse(cell.source).body
+                    if body and isinstance(body[-1], ast.Expr) and _WIDGET_CELL.search(ast.unparse(body[-1])):
+                        body = body[:-1]  # a widget shown: its picture costs time and holds nothing checked here
+                    exec(compile(ast.Module(body, []), f"{name}.ipynb", "exec"), namespace)
+        _NAMESPACES[name] = namespace
+    return _NAMESPACES[name]
+
+
+@contextlib.contextmanager
+def _in(folder: Path):
+    here = os.getcwd()
+    os.chdir(folder)
+    try:
+        yield
+    finally:
+        os.chdir(here)
+
+
+def _check(name: str, k: int, **answers):
+    """What the check cell of exercise ``k`` says for these answers (its last expression)."""
+    namespace = dict(_namespace(name), **answers)
+    source = next(c.source for c in _cells(name) if f"check-{k}" in c.metadata.get("tags", []))
+    body = ast.parse(source).body
+    with _in(WORKSHEETS):
+        exec(compile(ast.Module(body[:-1], []), "check", "exec"), namespace)
+        return eval(compile(ast.Expression(body[-1].value), "check", "eval"), namespace)
+
+
+def _forms(value) -> list[str]:
+    """How an expected number could be written in a message."""
+    values = value if isinstance(value, (tuple, list)) else [value]
+    forms = []
+    for v in values:
+        if isinstance(v, str):
+            forms.append(v)
+            continue
+        forms += {f"{v:g}", f"{v:.6g}", f"{v:.4g}", f"{v:.3g}", f"{v:.2f}", f"{v:.1f}"} - {"0", "0.0", "1", "1.0"}
+    return forms
+
+
+def _holds(message: str, value) -> bool:
+    return any(re.search(rf"(?<![\d.]){re.escape(form)}(?![\d])", message) for form in _forms(value))
+
+
+# -- the tests ---------------------------------------------------------------------------------------------------
+
+
+def test_curriculum_is_complete():
+    assert len(NAMES) >= 8
+    assert set(HAND) | {name for name, _ in WRONG_PROGRAMS} == set(NAMES)
+    exercises = {(name, int(t.split("-")[1])) for name in NAMES for c in _cells(name)
+                 for t in c.metadata.get("tags", []) if t.startswith("check-")}
+    numeric = {(name, k) for name, answers in HAND.items() for k in answers}
+    assert exercises == numeric | set(WRONG_PROGRAMS)  # every exercise is tested here
+    assert 3 * len(WRONG_PROGRAMS) >= len(exercises)  # at least a third write or edit G-code
+    readme = (WORKSHEETS / "README.md").read_text()
+    assert all(name in readme for name in NAMES)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_hand_answers_are_right_and_wrong_ones_say_what_is_wrong(name):
+    for k, value in HAND[name].items():
+        right = _check(name, k, **{f"answer_{k}": value})
+        assert right.ok, (name, k, right.message)
+        assert _check(name, k, **{f"answer_{k}": None}).ok is None
+        wrong = _check(name, k, **{f"answer_{k}": WRONG[name][k]})
+        assert wrong.ok is False and wrong.message.startswith("Not quite"), (name, k, wrong.message)
+        assert not _holds(wrong.message, value), (name, k, wrong.message)
+
+
+@pytest.mark.parametrize("exercise", sorted(WRONG_PROGRAMS), ids=lambda e: f"{e[0][:2]}-{e[1]}")
+def test_program_exercises_pass_the_right_program_and_name_what_is_wrong(exercise):
+    name, k = exercise
+    assert _check(name, k).ok, _check(name, k).message  # the teacher's program
+    assert _check(name, k, **{f"program_{k}": None}).ok is None
+    starting = _released_answer(name, k)
+    assert _check(name, k, **{f"program_{k}": starting}).ok is False  # the program as handed out
+    for make, said in WRONG_PROGRAMS[exercise]:
+        program = make()
+        assert program != _program(name, k)
+        result = _check(name, k, **{f"program_{k}": program})
+        assert result.ok is False and said in result.message, (name, k, program, result.message)
+
+
+def _released_answer(name: str, k: int):
+    """The value of ``program_k`` in the worksheet as released (the starting program)."""
+    source = next(c.source for c in _cells(name) if f"answer-{k}" in c.metadata.get("tags", []))
+    namespace = dict(_namespace(name))
+    with _in(WORKSHEETS):
+        exec(source.split("### BEGIN SOLUTION")[0], namespace)
+    return namespace[f"program_{k}"]
+
+
+@pytest.mark.parametrize("fact", STATED_LINES, ids=lambda f: f"{f[0]}-{f[1]}-{f[2]}")
+def test_line_numbers_the_worksheets_state(fact):
+    number, program, line, text = fact
+    lines = (WORKSHEETS / "programs" / program).read_text().splitlines()
+    assert lines[line - 1].startswith(text), (program, line, lines[line - 1])
+    worksheet = next(n for n in NAMES if n.startswith(number))
+    text = " ".join(c.source for c in _cells(worksheet))
+    said = {int(n) for n in re.findall(r"\bline (\d+)\b", text, re.I)}
+    said |= {n for a, b in re.findall(r"\blines (\d+)-(\d+)\b", text, re.I) for n in range(int(a), int(b) + 1)}
+    assert line in said, (worksheet, line)
+
+
+def test_zigzag_length_stated_in_worksheet_7():
+    import gcodekit
+
+    op = gcodekit.gcode_to_operation(str(WORKSHEETS / "programs" / "zigzag.gcode"), "grbl", plan=False)
+    assert float(op.waypoints["distance"].sum()) == pytest.approx(437.2426, abs=1e-4)
+    assert "437.24 mm" in " ".join(c.source for c in _cells("07-planned-against-naive-time"))
+
+
+def test_layer_times_stated_in_worksheet_9():
+    import gcodekit
+
+    op = gcodekit.gcode_to_operation(str(WORKSHEETS / "programs" / "cube20_prusaslicer_marlin.gcode"))
+    times = gcodekit.AdditivePart(op).layer_times().time
+    assert times.idxmax() == 0 and round(times.max()) == 65
+    assert 0 < times.idxmin() < 99 and round(times.min()) == 11  # a middle layer, not the first or the top
+
+
+# -- nbgrader ------------------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def course(tmp_path_factory):
+    """A course directory with the worksheets as one assignment, released and autograded for three students.
+
+    ``right`` hands in the teacher's answers, ``empty`` the released worksheets as they are, ``wrong`` a wrong
+    answer (the first wrong program) in every exercise.
+    """
+    import sys
+
+    from nbgrader.apps import NbGraderAPI
+    from traitlets.config import Config
+
+    # nbgrader runs its `alembic` command by name: this environment's scripts first on the path
+    path = os.environ["PATH"]
+    os.environ["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{path}"
+    try:
+        yield _graded_course(tmp_path_factory.mktemp("course"), NbGraderAPI, Config)
+    finally:
+        os.environ["PATH"] = path
+
+
+def _graded_course(root: Path, NbGraderAPI, Config):
+    """The course of the fixture above, graded: (root, scores)."""
+    source = root / "source" / "worksheets"
+    shutil.copytree(WORKSHEETS, source, ignore=shutil.ignore_patterns("README.md", "nbgrader_config.py", "*.html"))
+    shutil.copy(WORKSHEETS / "nbgrader_config.py", root / "nbgrader_config.py")
+    config = Config()
+    exec((WORKSHEETS / "nbgrader_config.py").read_text(), {"get_config": lambda: config})
+    config.CourseDirectory.root = str(root)
+    config.CourseDirectory.db_url = f"sqlite:///{root / 'gradebook.db'}"
+    config.ExecutePreprocessor.timeout = 600
+    api = NbGraderAPI(config=config)
+    with _in(root):
+        generated = api.generate_assignment("worksheets")
+    assert generated["success"], generated["log"]
+    released = root / "release" / "worksheets"
+    for student in ("right", "empty", "wrong"):
+        folder = root / "submitted" / student / "worksheets"
+        shutil.copytree(released, folder)
+        (folder / "timestamp.txt").write_text("2026-12-03 12:00:00.000000 UTC")
+    for name in NAMES:
+        for cell_source in (WORKSHEETS / f"{name}.ipynb",):
+            src = nbformat.read(cell_source, as_version=4)
+            for student, answer in (("right", _teacher), ("wrong", _wrong)):
+                path = root / "submitted" / student / "worksheets" / f"{name}.ipynb"
+                nb = nbformat.read(path, as_version=4)
+                for cell, original in zip(nb.cells, src.cells):
+                    tags = original.metadata.get("tags", [])
+                    if any(t.startswith("answer-") for t in tags):
+                        cell.source = answer(name, int(tags[0].split("-")[1]), original.source)
+                nbformat.write(nb, path)
+    with _in(root):
+        for student in ("right", "empty", "wrong"):
+            result = api.autograde("worksheets", student)
+            assert result["success"], result["log"]
+            feedback = api.generate_feedback("worksheets", student)
+            assert feedback["success"], feedback["log"]
+    from nbgrader.api import Gradebook
+
+    with Gradebook(f"sqlite:///{root / 'gradebook.db'}") as gradebook:
+        scores = {(student, name): (gradebook.find_submission_notebook(name, "worksheets", student).score,
+                                    gradebook.find_notebook(name, "worksheets").max_score)
+                  for student in ("right", "empty", "wrong") for name in NAMES}
+    return root, scores
+
+
+def _teacher(name: str, k: int, source: str) -> str:
+    """The answer cell with the teacher's answer, as a student would write it (no solution markers)."""
+    return re.sub(r"### (BEGIN|END) SOLUTION\n?", "", source)
+
+
+def _wrong(name: str, k: int, source: str) -> str:
+    if (name, k) in WRONG_PROGRAMS:
+        return f"program_{k} = {WRONG_PROGRAMS[(name, k)][0][0]()!r}"
+    return f"answer_{k} = {WRONG[name][k]!r}"
+
+
+def test_nbgrader_releases_without_the_answers(course):
+    root, _ = course
+    for name in NAMES:
+        released = (root / "release" / "worksheets" / f"{name}.ipynb").read_text()
+        assert "BEGIN SOLUTION" not in released and "answer_1 = None" in released or "program_" in released
+        for k, value in HAND.get(name, {}).items():
+            line = next(c.source for c in _cells(name) if f"answer-{k}" in c.metadata.get("tags", []))
+            solution = line.split("### BEGIN SOLUTION\n")[1].split("\n### END SOLUTION")[0]
+            assert solution not in released, (name, k)
+    assert (root / "release" / "worksheets" / "programs" / "tools.tbl").exists()
+
+
+def test_nbgrader_autograde_scores(course):
+    root, scores = course
+    for name in NAMES:
+        score, most = scores[("right", name)]
+        assert most > 0 and score == most, (name, scores[("right", name)])
+        assert scores[("empty", name)][0] == 0, (name, scores[("empty", name)])
+        assert scores[("wrong", name)][0] == 0, (name, scores[("wrong", name)])
+
+
+def test_autograded_notebooks_run_to_the_end_and_feedback_keeps_answers_hidden(course):
+    root, _ = course
+    for student in ("right", "empty", "wrong"):
+        for name in NAMES:
+            nb = nbformat.read(root / "autograded" / student / "worksheets" / f"{name}.ipynb", as_version=4)
+            outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
+            assert not [o for o in outputs if o.output_type == "error"], (student, name)
+            if student != "wrong":
+                continue
+            said = " ".join(o.get("text", "") for c in nb.cells if any(t.startswith("check-") for t in
+                                                                         c.metadata.get("tags", []))
+                            for o in c.outputs)
+            for k, value in HAND.get(name, {}).items():
+                assert not _holds(said, value), (name, k, said)
+            page = (root / "feedback" / student / "worksheets" / f"{name}.html").read_text()
+            assert "Not quite" in page or "Not yet" in page
+
+
+# -- handing in as HTML ------------------------------------------------------------------------------------------
+
+WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
+_REMOTE_SCRIPT = re.compile(r"<script[^>]*\ssrc=[\"']?(https?:)?//", re.I)
+
+
+@pytest.fixture(scope="module")
+def handed_in(course, tmp_path_factory):
+    """The right hand-ins as nbgrader executed them, converted by plain ``jupyter nbconvert --to html``."""
+    import subprocess
+    import sys
+
+    root, _ = course
+    folder = tmp_path_factory.mktemp("hand-in")
+    for name in NAMES:
+        shutil.copy(root / "autograded" / "right" / "worksheets" / f"{name}.ipynb", folder)
+    jupyter = Path(sys.executable).parent / "jupyter"
+    done = subprocess.run([str(jupyter), "nbconvert", "--to", "html", *[f"{n}.ipynb" for n in NAMES]], cwd=folder,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return folder
+
+
+def _widget_outputs(nb) -> int:
+    return sum(WIDGET_VIEW in o.get("data", {}) for c in nb.cells if c.cell_type == "code" for o in c.outputs)
+
+
+def test_plain_nbconvert_shows_one_picture_per_widget_and_no_remote_script(handed_in):
+    for name in NAMES:
+        nb = nbformat.read(handed_in / f"{name}.ipynb", as_version=4)
+        page = (handed_in / f"{name}.html").read_text()
+        widgets = _widget_outputs(nb)
+        assert widgets > 0, name
+        pictures = len(re.findall(r'<img[^>]+src="data:image/png;base64,', page))
+        assert pictures == widgets, (name, pictures, widgets)
+        assert not _REMOTE_SCRIPT.search(page), (name, _REMOTE_SCRIPT.search(page))
+        assert WIDGET_VIEW not in page and "html-manager" not in page
+
+
+def test_handed_in_pages_show_their_pictures_offline_in_chromium(handed_in):
+    from jupyter_browser import browser_page, chromium_path
+
+    if chromium_path() is None:
+        pytest.skip("chromium not found: apt-get install chromium (scripts/setup.sh does as root)")
+    import numpy as np
+    from PIL import Image
+
+    with browser_page() as page:
+        page.context.set_offline(True)
+        for name in NAMES:
+            page.goto((handed_in / f"{name}.html").as_uri())
+            page.wait_for_load_state("load")
+            sizes = page.evaluate("[...document.images].map(i => [i.naturalWidth, i.naturalHeight])")
+            assert sizes and all(w > 100 and h > 100 for w, h in sizes), (name, sizes)
+            # looked at as a picture: the first widget's picture as the page shows it holds a drawing, not a blank
+            shot = page.locator("img").first.screenshot()
+            pixels = np.asarray(Image.open(io.BytesIO(shot)).convert("L"), float)
+            assert pixels.std() > 10 and (pixels < 250).mean() > 0.01, name
+        assert page.console_errors == []
+
+
+def test_jupyterlab_export_shows_the_pictures_offline(handed_in, tmp_path):
+    """JupyterLab's File > Save and Export Notebook As > HTML asks the server's /nbconvert/html handler."""
+    from jupyter_browser import browser_page, chromium_path, jupyter_lab
+
+    if chromium_path() is None:
+        pytest.skip("chromium not found: apt-get install chromium (scripts/setup.sh does as root)")
+    name = "06-cutter-compensation-and-stages"
+    shutil.copy(handed_in / f"{name}.ipynb", tmp_path)
+    with jupyter_lab(tmp_path) as url, browser_page() as page:
+        page.goto(f"{url}/lab")
+        # what the menu item opens: the server's exporter, asked from the JupyterLab page
+        response = page.request.get(f"{url}/nbconvert/html/{name}.ipynb?download=true", headers={"Referer": f"{url}/lab"})
+        assert response.ok, response.status
+        page_html = response.text()
+    nb = nbformat.read(tmp_path / f"{name}.ipynb", as_version=4)
+    assert len(re.findall(r'<img[^>]+src="data:image/png;base64,', page_html)) == _widget_outputs(nb) == 2
+    assert not _REMOTE_SCRIPT.search(page_html) and WIDGET_VIEW not in page_html
