@@ -1,7 +1,11 @@
-"""Output stage: pictures of an operation, 3D with PyVista and 2D layers with matplotlib.
+"""Output stage: pictures of an operation, 3D with PyVista and 2D projections with matplotlib.
 
-Both libraries load on first use.  3D pictures render off-screen through EGL
-unless ``VTK_DEFAULT_OPENGL_WINDOW`` says otherwise, so they work on a machine
+Both draw the one :class:`~gcodekit.view.Toolpath` (segments, arcs in
+chords) coloured by the one :class:`~gcodekit.view.Coloring`, seen by the
+orthographic :class:`~gcodekit.view.Camera` the notebook viewer uses, so a
+PNG, a report figure and the viewer show a program alike.  Both libraries
+load on first use.  3D pictures render off-screen through EGL unless
+``VTK_DEFAULT_OPENGL_WINDOW`` says otherwise, so they work on a machine
 without a display.
 
 Examples
@@ -20,113 +24,50 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import NothingToShowError, check_choice
+from .errors import NothingToShowError
+from .view import TRAVEL, TRAVEL_COLOR, WORK, Camera, Coloring, Toolpath, coloring, default_coloring
 
 if TYPE_CHECKING:
     import pyvista as pv
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
     from .additive.part import AdditivePart
     from .model.operation import Operation
 
-CAMERAS = ("iso", "top", "front", "side")
-#: Scalars with a meaning beyond a waypoint column, and the colour-bar title of each.
-NAMED_SCALARS = {"feature": "feature", "speed": "speed (mm/s)", "layer": "layer", "time": "elapsed time (s)",
-                 "feed": "feed (mm/min)", "tool": "tool", "laser": "heat source on"}
-_TRAVEL_COLOR = "#9a9a9a"
-#: matplotlib's "tab10", one colour per category (a colormap name would be sampled at its ends for two)
-_CATEGORY_COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
-                    "#bcbd22", "#17becf"]
 _MAX_GLYPHS = 300
 
 
-def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
-    """Waypoints that are the work and the rest of the moves.
+def toolpath_polydata(path: Toolpath, color: Coloring) -> tuple["pv.PolyData", "pv.PolyData"]:
+    """The work segments (``color``'s values as cell data named ``color.by``) and the travel segments as meshes.
 
-    The work is the depositing moves from the first layer on (start-code purge
-    lines are not the part) or, for a mill, the feed moves.
+    Each segment is a line cell of two points; for 5-axis programs the work
+    mesh also carries each segment's ``tool_vector``.
     """
-    moving = op.moving.copy()
-    moving[:1] = False  # a move is drawn from the waypoint before it
-    work = op.work & moving
-    return work, moving & ~work
-
-
-def waypoint_scalars(op: "Operation", scalars: str) -> tuple[np.ndarray, list[str] | None]:
-    """Values of ``scalars`` at every waypoint, and category names for a categorical one.
-
-    ``feature`` (slicer ``;TYPE:`` or DED fraction comments), ``speed`` (each
-    move's length over its planned time, mm/s), ``layer``, ``time`` (elapsed,
-    s), or any waypoint column (``feed``, ``tool``, ``laser``, ``z`` ...).
-    """
-    w = op.waypoints
-    if scalars == "feature":
-        names, codes = np.unique(op.features.astype(str), return_inverse=True)
-        return codes.astype(np.int32), [n or "(none)" for n in names.tolist()]
-    if scalars == "speed":
-        d, t = np.asarray(w["distance"], float), np.nan_to_num(np.asarray(w["time"], float))
-        return np.divide(d, t, out=np.zeros_like(d), where=t > 0), None
-    if scalars == "layer":
-        return op.layers, None
-    if scalars in ("time", "elapsed_time"):
-        return op.elapsed_time(), None
-    check_choice("scalars", scalars, [*NAMED_SCALARS, *sorted(k for k in w if k not in NAMED_SCALARS and k != "command")])
-    return np.asarray(w[scalars]), None
-
-
-def _lines(pv, w: dict, xyz: np.ndarray, rows: np.ndarray) -> "pv.PolyData":
-    """One line cell per move (move ``i`` runs from waypoint ``i-1`` to ``i``).
-
-    The cells share the waypoint points; an arc's cell passes through its
-    interior points (every 5 degrees), added after them.
-    """
-    from .emulate.arcs import waypoint_arc_points
-
-    interior, counts = waypoint_arc_points(w, rows)
-    size = counts + 2
-    # VTK's cell array: per cell its size, its start, its interior points, its end
-    cells = np.empty(int((size + 1).sum()), np.int64)
-    head = np.cumsum(size + 1) - (size + 1)
-    cells[head] = size
-    cells[head + 1] = rows - 1
-    cells[head + size] = rows
-    inside = np.ones(cells.size, bool)
-    inside[np.r_[head, head + 1, head + size]] = False
-    cells[inside] = xyz.shape[0] + np.arange(interior.shape[0])
-    mesh = pv.PolyData(np.vstack([xyz, interior]) if interior.size else xyz, lines=cells)
-    # the points no cell uses (the rest of the program) must not move the camera
-    drawn = np.vstack([xyz[np.r_[rows - 1, rows]], interior])
-    if drawn.size:
-        mesh.field_data["drawn_bounds"] = np.r_[drawn.min(axis=0), drawn.max(axis=0)]
-    return mesh
-
-
-def operation_polydata(op: "Operation", scalars: str = "feature") -> tuple["pv.PolyData", "pv.PolyData", list | None]:
-    """The work moves (with ``scalars`` as cell data) and the travel moves of ``op`` as line meshes."""
     from .export.vtk import import_pyvista
 
     pv = import_pyvista()
-    w = op.waypoints
-    xyz = np.column_stack([np.asarray(w[k], float) for k in "xyz"])
-    work, travel = move_masks(op)
-    values, categories = waypoint_scalars(op, scalars)
-    work_rows = np.flatnonzero(work)
-    mesh = _lines(pv, w, xyz, work_rows)
-    values = values[work_rows]
-    if categories is not None:  # keep the categories the drawn moves have
-        used, values = np.unique(values, return_inverse=True)
-        categories = [categories[k] for k in used]
-    mesh.cell_data[scalars] = values
-    a, b = np.asarray(w["a"], float), np.asarray(w["b"], float)
-    if np.any(a != 0) or np.any(b != 0):
-        from .analysis import tool_vectors
+    meshes = []
+    for kind in (WORK, TRAVEL):
+        keep = np.flatnonzero(path.kind == kind)
+        n = keep.size
+        cells = np.column_stack([np.full(n, 2), np.arange(n), np.arange(n, 2 * n)]).ravel()
+        mesh = pv.PolyData(np.vstack([path.start[keep], path.end[keep]]), lines=cells)
+        if kind == WORK:
+            mesh.cell_data[color.by] = color.values[keep]
+            w = path.op.waypoints
+            a, b = np.asarray(w["a"], float), np.asarray(w["b"], float)
+            if np.any(a != 0) or np.any(b != 0):
+                from .analysis import tool_vectors
 
-        mesh.cell_data["tool_vector"] = tool_vectors(a[work_rows], b[work_rows])
-    return mesh, _lines(pv, w, xyz, np.flatnonzero(travel)), categories
+                rows = path.move_rows[path.move_of[keep]]
+                mesh.cell_data["tool_vector"] = tool_vectors(a[rows], b[rows])
+        meshes.append(mesh)
+    return meshes[0], meshes[1]
 
 
 def _glyphs(pv, mesh: "pv.PolyData", size: float) -> "pv.PolyData":
-    """Arrows along the tool direction at up to ``_MAX_GLYPHS`` moves."""
+    """Arrows along the tool direction at up to ``_MAX_GLYPHS`` segments."""
     centers = mesh.cell_centers()
     step = max(1, centers.n_points // _MAX_GLYPHS)
     picked = pv.PolyData(centers.points[::step])
@@ -134,16 +75,14 @@ def _glyphs(pv, mesh: "pv.PolyData", size: float) -> "pv.PolyData":
     return picked.glyph(orient="tool_vector", scale=False, factor=size, geom=pv.Arrow())
 
 
-def default_scalars(op: "Operation") -> str:
-    """``feature`` when the program names its features, else ``layer`` (additive) or ``feed``."""
-    if op.flavor is not None and op.flavor.feature_comment and (op.features != "").any():
-        return "feature"
-    return "layer" if op.process == "additive" else "feed"
+def fitted_camera(camera: "str | Camera", path: Toolpath, aspect: float) -> Camera:
+    """A Camera as given, or a named one (:data:`gcodekit.view.CAMERAS`) framing the work of ``path`` tightly."""
+    return camera if isinstance(camera, Camera) else Camera.named(camera).fitted(path, aspect)
 
 
 def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: bool = False,
                    tool_vectors: bool = False, off_screen: bool = True, screenshot: str | os.PathLike | None = None,
-                   camera: str = "iso", window_size: tuple[int, int] = (1200, 900), line_width: float = 2.0,
+                   camera: "str | Camera" = "iso", window_size: tuple[int, int] = (1200, 900), line_width: float = 2.0,
                    cmap: str | None = None, background: str = "white",
                    scalar_bar: bool = True) -> np.ndarray | None:
     """Draw the toolpath of an emulated operation in 3D with PyVista.
@@ -153,8 +92,8 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
     op : Operation
     scalars : str, default: None
         Colour by ``feature``, ``speed``, ``layer``, ``time`` or any waypoint
-        column (see :func:`waypoint_scalars`); None picks ``feature`` when
-        the program marks features, else ``layer`` (additive) or ``feed``.
+        column (see :func:`gcodekit.view.coloring`); None picks ``feature``
+        when the program marks features, else ``layer`` (additive) or ``feed``.
     show_travel : bool, default: False
         Also draw the moves that lay no material (rapids for a mill), grey.
     tool_vectors : bool, default: False
@@ -163,7 +102,11 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
         Render without a window; False opens an interactive one.
     screenshot : path, default: None
         Write a PNG of the picture there.
-    camera : {"iso", "top", "front", "side"}, default: "iso"
+    camera : {"iso", "top", "front", "side"} or Camera, default: "iso"
+        Orthographic; a name frames the work tightly, a :class:`gcodekit.view.Camera` is taken as it is
+        (the notebook viewer's ``viewer.camera`` gives the viewer's picture).
+    cmap : str, default: None
+        A matplotlib colormap instead of the shared palette (viridis, or the category colours).
     scalar_bar : bool, default: True
         Draw the colour bar (the legend of a categorical scalar).
 
@@ -171,43 +114,47 @@ def plot_operation(op: "Operation", scalars: str | None = None, *, show_travel: 
     -------
     The image as an (height, width, 3) array when off-screen, else None.
     """
-    check_choice("camera", camera, CAMERAS)
+    if not isinstance(camera, Camera):
+        Camera.named(camera)  # a bad name fails before any work
     if not _is_emulated(op):
         raise ValueError(f"{op.file}: plot_operation needs an emulated operation (use gcode_to_operation)")
     from .export.vtk import import_pyvista
 
     pv = import_pyvista()
-    scalars = scalars or default_scalars(op)
-    mesh, travel, categories = operation_polydata(op, scalars)
+    path = Toolpath.of(op)
+    scalars = scalars or default_coloring(op)
+    color = coloring(path, scalars)
+    mesh, travel = toolpath_polydata(path, color)
     if mesh.n_cells == 0 and (travel.n_cells == 0 or not show_travel):
         raise NothingToShowError(f"{op.file}: nothing to draw (no {'deposition' if op.process == 'additive' else 'feed'} "
                                  "moves)")
     plotter = pv.Plotter(off_screen=off_screen, window_size=list(window_size))
     plotter.set_background(background)
-    bar: dict[str, Any] = dict(title=NAMED_SCALARS.get(scalars, scalars), color="black", vertical=True,
+    categories = color.categories
+    bar: dict[str, Any] = dict(title=color.title, color="black", vertical=True,
                                position_x=0.88, position_y=0.1, height=0.8, width=0.04,
                                title_font_size=18, label_font_size=14,
-                               fmt="%.0f" if mesh[scalars].dtype.kind in "iu" else "%.4g")
-    kwargs: dict[str, Any] = dict(scalars=scalars, line_width=line_width, scalar_bar_args=bar,
-                                  show_scalar_bar=scalar_bar,
-                                  cmap=cmap or "viridis")
+                               fmt="%.0f" if categories else "%.4g")
+    # lines unlit: a segment shows its colour as the other pictures do, whichever way it faces
+    kwargs: dict[str, Any] = dict(scalars=scalars, line_width=line_width, scalar_bar_args=bar, lighting=False,
+                                  show_scalar_bar=scalar_bar, cmap=cmap or color.cmap(),
+                                  clim=list(color.value_range(path.kind == WORK)))
     if categories:
-        if cmap is None:
-            kwargs["cmap"] = _CATEGORY_COLORS[:len(categories)] if len(categories) <= 10 else "tab20"
-        kwargs.update(categories=True, clim=[-0.5, len(categories) - 0.5],
-                      annotations={k: name for k, name in enumerate(categories)})
+        # one colour per category index, whichever indices the work has (PyVista's categories=True would
+        # number the present values afresh and shift the colours)
+        kwargs.update(clim=[-0.5, len(categories) - 0.5], n_colors=len(categories),
+                      annotations={float(k): name for k, name in enumerate(categories)})
         bar.update(n_labels=0, n_colors=len(categories))
+    else:
+        kwargs["n_colors"] = 256
     if mesh.n_cells:
         plotter.add_mesh(mesh, **kwargs)
     if show_travel and travel.n_cells:
-        plotter.add_mesh(travel, color=_TRAVEL_COLOR, line_width=max(line_width / 2, 1.0), opacity=0.6)
+        plotter.add_mesh(travel, color=TRAVEL_COLOR, line_width=max(line_width / 2, 1.0), lighting=False)
     if tool_vectors and "tool_vector" in mesh.cell_data:
-        lo_hi = mesh.field_data["drawn_bounds"]
-        size = 0.04 * float(np.linalg.norm(lo_hi[3:] - lo_hi[:3]))
-        plotter.add_mesh(_glyphs(pv, mesh, size), color="#d62728")
-    {"iso": plotter.view_isometric, "top": plotter.view_xy, "front": plotter.view_xz,
-     "side": plotter.view_yz}[camera]()
-    _frame(plotter, mesh if mesh.n_cells else travel)
+        lo, hi = path.bounds()
+        plotter.add_mesh(_glyphs(pv, mesh, 0.04 * float(np.linalg.norm(hi - lo))), color="#d62728")
+    _place(plotter, path, fitted_camera(camera, path, window_size[0] / window_size[1]))
     if not off_screen:
         plotter.show()
         return None
@@ -220,11 +167,70 @@ def _is_emulated(op) -> bool:
     return getattr(op, "waypoints", None) is not None
 
 
-def _frame(plotter, mesh) -> None:
-    """Fit the camera to the drawn moves only (not the machine's home position)."""
-    lo, hi = mesh.field_data["drawn_bounds"][:3], mesh.field_data["drawn_bounds"][3:]
-    plotter.reset_camera(bounds=[lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]])
-    plotter.camera.zoom(1.05)
+def _place(plotter, path: Toolpath, camera: Camera) -> None:
+    """Look at the work as ``camera`` says: orthographic, the work's sphere filling the height at zoom 1."""
+    middle, radius = path.frame()
+    centre, half = camera.view(middle, radius)
+    _, up, eye = camera.axes()
+    plotter.enable_parallel_projection()
+    plotter.camera.focal_point = tuple(centre)
+    plotter.camera.position = tuple(centre + eye * radius * 10)
+    plotter.camera.up = tuple(up)
+    plotter.camera.parallel_scale = half
+    plotter.camera.clipping_range = (radius * 8, radius * 12)
+
+
+def draw_toolpath(ax: "Axes", path: Toolpath, color: Coloring, camera: Camera, segments: np.ndarray, *,
+                  work_width: float = 1.0, travel_width: float = 0.5, absolute: bool = False) -> tuple[float, float]:
+    """Draw ``segments`` of ``path`` on a 2D matplotlib Axes as ``camera`` sees them; returns the colour scale.
+
+    Far segments are drawn first (a painter's order), so nearer ones cover
+    them, as a depth buffer would.  The Axes' limits frame the work as the
+    camera does (call ``set_xlim``/``set_ylim`` to frame otherwise);
+    ``absolute`` keeps machine coordinates on the axes (for a ``top`` view:
+    X and Y in mm), else they are mm from the point looked at.
+    """
+    from matplotlib.collections import LineCollection
+
+    right, up, eye = camera.axes()
+    middle, radius = path.frame()
+    centre, half = camera.view(middle, radius)
+    origin = np.zeros(3) if absolute else centre
+    rgb, vmin, vmax = color.segment_rgb(path, segments)
+    p0, p1 = path.start[segments] - origin, path.end[segments] - origin
+    order = np.argsort((p0 + p1) @ eye, kind="stable")
+    lines = np.stack([np.column_stack([p0 @ right, p0 @ up]), np.column_stack([p1 @ right, p1 @ up])], axis=1)
+    widths = np.where(path.kind[segments] == WORK, work_width, travel_width)[order]
+    ax.add_collection(LineCollection(lines[order], colors=rgb[order], linewidths=widths))
+    x0, y0 = (centre - origin) @ right, (centre - origin) @ up
+    box = ax.get_position()
+    fig_w, fig_h = ax.figure.get_size_inches()
+    aspect = (box.width * fig_w) / (box.height * fig_h)
+    ax.set_xlim(x0 - half * aspect, x0 + half * aspect)
+    ax.set_ylim(y0 - half, y0 + half)
+    return vmin, vmax
+
+
+def add_legend(fig: "Figure", color: Coloring, path: Toolpath, segments: np.ndarray, vmin: float, vmax: float, *,
+               rect: tuple[float, float, float, float] = (0.82, 0.1, 0.03, 0.8), fontsize: float = 8) -> None:
+    """The colour bar, or one swatch per category present among the work of ``segments``."""
+    work = segments[path.kind[segments] == WORK]
+    if color.categories is not None:
+        import matplotlib.patches as mpatches
+
+        used = color.used(work)
+        rgb = color.rgb(np.asarray(used), 0, 1)
+        handles = [mpatches.Patch(color=rgb[k], label=color.categories[c]) for k, c in enumerate(used)]
+        fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(rect[0] - 0.04, rect[1] + rect[3] + 0.05),
+                   fontsize=fontsize, frameon=False, title=color.title, title_fontsize=fontsize + 1)
+        return
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
+    cax = fig.add_axes(list(rect))
+    bar = fig.colorbar(ScalarMappable(Normalize(vmin, vmax if vmax > vmin else vmin + 1), color.cmap()), cax=cax)
+    bar.set_label(color.title, fontsize=fontsize + 1)
+    bar.ax.tick_params(labelsize=fontsize)
 
 
 def plot_layer(source: "Operation | AdditivePart", layer: int, *, ax: "Axes | None" = None,
@@ -247,39 +253,37 @@ def plot_layer(source: "Operation | AdditivePart", layer: int, *, ax: "Axes | No
     op = getattr(source, "operation", source)
     if not _is_emulated(op):
         raise ValueError(f"{op.file}: plot_layer needs an emulated operation (use gcode_to_operation)")
-    in_layer = (source.waypoint_layer if hasattr(source, "waypoint_layer") else op.layers) == layer
-    work, travel = move_masks(op)
-    if not (work & in_layer).any():
+    path = Toolpath.of(source, "layer")
+    in_layer = path.segment_group == layer
+    work = np.flatnonzero(in_layer & (path.kind == WORK))
+    if work.size == 0:
         raise NothingToShowError(f"{op.file}: layer {layer} has no deposition moves")
     if ax is None:
         import matplotlib.pyplot as plt
 
         ax = plt.subplots(figsize=(7, 6))[1]
-    w = op.waypoints
-    xy = np.column_stack([np.asarray(w["x"], float), np.asarray(w["y"], float)])
-
-    def segments(mask):
-        rows = np.flatnonzero(mask)
-        return np.stack([xy[rows - 1], xy[rows]], axis=1), rows
-
-    values, categories = waypoint_scalars(op, scalars)
-    segs, rows = segments(work & in_layer)
-    lines = LineCollection(segs, linewidths=line_width, cmap="tab10" if categories else "viridis")
-    lines.set_array(values[rows].astype(float))
-    if categories:
-        lines.set_clim(-0.5, 9.5)
-    ax.add_collection(lines)
+    color = coloring(path, scalars)
+    rgb, vmin, vmax = color.segment_rgb(path, work)
+    xy = lambda p, keep: p[keep][:, :2]  # noqa: E731
+    ax.add_collection(LineCollection(np.stack([xy(path.start, work), xy(path.end, work)], axis=1), colors=rgb,
+                                     linewidths=line_width))
     if show_travel:
-        tsegs, _ = segments(travel & in_layer)
-        ax.add_collection(LineCollection(tsegs, linewidths=0.5, colors=_TRAVEL_COLOR, linestyles="dashed"))
-    if categories:
+        travel = np.flatnonzero(in_layer & (path.kind == TRAVEL))
+        ax.add_collection(LineCollection(np.stack([xy(path.start, travel), xy(path.end, travel)], axis=1),
+                                         linewidths=0.5, colors=TRAVEL_COLOR, linestyles="dashed"))
+    if color.categories is not None:
         import matplotlib.lines as mlines
 
-        used = np.unique(values[rows])
-        handles = [mlines.Line2D([], [], color=lines.cmap(lines.norm(k)), label=categories[k]) for k in used]
+        used = color.used(work)
+        handles = [mlines.Line2D([], [], color=color.rgb(np.array([k]), 0, 1)[0], label=color.categories[k])
+                   for k in used]
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
     else:
-        ax.figure.colorbar(lines, ax=ax, label=NAMED_SCALARS.get(scalars, scalars))
+        from matplotlib.cm import ScalarMappable
+        from matplotlib.colors import Normalize
+
+        ax.figure.colorbar(ScalarMappable(Normalize(vmin, vmax if vmax > vmin else vmin + 1), color.cmap()), ax=ax,
+                           label=color.title)
     ax.autoscale()
     ax.set_aspect("equal")
     ax.set_xlabel("X (mm)")

@@ -28,8 +28,8 @@ STAGES: list[tuple[str, ...]] = [
     ("gcodekit.emulate",),
     ("gcodekit.plan",),
     ("gcodekit.model",),
-    ("gcodekit.analysis", "gcodekit.additive", "gcodekit.export", "gcodekit.visualize", "gcodekit.transpile",
-     "gcodekit.cut"),
+    ("gcodekit.analysis", "gcodekit.additive", "gcodekit.export", "gcodekit.view", "gcodekit.visualize",
+     "gcodekit.transpile", "gcodekit.cut"),
     ("gcodekit.pipeline",),
     ("gcodekit.report", "gcodekit.widgets", "gcodekit.cli", "gcodekit.testing", "gcodekit.path", "gcodekit"),
 ]

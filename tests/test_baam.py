@@ -71,10 +71,10 @@ def test_additive_part_counts_the_screws_volume_per_layer():
 
 
 def test_report_draws_the_screw_deposits():
-    from gcodekit.report.figures import toolpath_segments
+    from gcodekit.report.figures import toolpath_drawing
 
-    seg = toolpath_segments(gcodekit.gcode_to_operation(WALL))
-    assert len(seg.start) == 8  # the two perimeters' eight sides, no travel
+    drawing = toolpath_drawing(gcodekit.gcode_to_operation(WALL))
+    assert len(drawing.segments) == 8  # the two perimeters' eight sides, no travel
 
 
 def test_material_event_series_follows_the_screw():

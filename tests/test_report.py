@@ -21,7 +21,8 @@ import gcodekit
 from gcodekit import cli
 from gcodekit.report import ReportOptions, report_program, write_reports
 from gcodekit.report.build import report_data
-from gcodekit.report.figures import ARC_CHORDS, toolpath_segments
+from gcodekit.report.figures import toolpath_drawing
+from gcodekit.view import CHORD_ANGLE_DEG
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 MILL = EXAMPLES / "bracket_mill.ngc"
@@ -82,24 +83,28 @@ def test_mill_program_has_stages_and_toolpath_breakdown_by_tool():
 
 
 def test_arcs_are_drawn_as_chords_on_their_circle():
-    op = gcodekit.gcode_to_operation("G0 X10 Y0\nG3 X10 Y0 I-10 J0 F600\n", machine="linuxcnc")
-    seg = toolpath_segments(op)
-    arc = seg.start.shape[0] - ARC_CHORDS
-    assert arc == 1  # the rapid, then the full circle in ARC_CHORDS pieces
+    # the first move starts where the machine was before the program, which no waypoint holds: not drawn
+    op = gcodekit.gcode_to_operation("G0 X0 Y0\nG0 X10 Y0\nG3 X10 Y0 I-10 J0 F600\n", machine="linuxcnc")
+    seg = toolpath_drawing(op)
+    chords = int(np.ceil(360 / CHORD_ANGLE_DEG))  # 72: the full circle in chords of at most 5 degrees
+    arc = seg.start.shape[0] - chords
+    assert arc == 1  # the rapid, then the full circle
     points = np.vstack([seg.start[arc:], seg.end[-1:]])
     assert np.allclose(np.hypot(points[:, 0], points[:, 1]), 10.0)
     angles = np.unwrap(np.arctan2(points[:, 1], points[:, 0]))
     assert angles[-1] - angles[0] == pytest.approx(2 * np.pi)  # counter-clockwise, once round
+    assert np.diff(angles).max() <= np.radians(CHORD_ANGLE_DEG) + 1e-12
 
 
 def test_only_depositing_arcs_are_drawn_in_a_print():
     program = "M83\nG1 Z0.2 F600\nG2 X10 Y0 I5 J0 E1 F1200\nG2 X0 Y0 I-5 J0\nG3 X10 Y0 I5 J0 E1\n"
     op = gcodekit.gcode_to_operation(program, machine="marlin")
-    seg = toolpath_segments(op)
-    assert seg.start.shape[0] == 2 * ARC_CHORDS  # the travel arc between them is left out
+    seg = toolpath_drawing(op)
+    half = int(np.ceil(180 / CHORD_ANGLE_DEG))  # each half circle in 36 chords
+    assert seg.start.shape[0] == 2 * half  # the travel arc between them is left out
     assert np.allclose(np.hypot(seg.end[:, 0] - 5, seg.end[:, 1]), 5.0)
     # left to right, clockwise passes above the centre and counter-clockwise below
-    assert (seg.end[:ARC_CHORDS, 1] >= -1e-9).all() and (seg.end[ARC_CHORDS:, 1] <= 1e-9).all()
+    assert (seg.end[:half, 1] >= -1e-9).all() and (seg.end[half:, 1] <= 1e-9).all()
 
 
 def test_comments_and_file_names_are_escaped(tmp_path):
@@ -115,6 +120,19 @@ def test_comments_and_file_names_are_escaped(tmp_path):
         assert "&lt;script&gt;alert(1)" in html
     assert page.count("&lt;script&gt;alert(1)&lt;/script&gt;") >= 2  # the feature name and the diagnostic
     assert rows[0]["html"] == "_script_alert_1_.gcode.html"
+
+
+def test_markup_in_feature_names_is_text_on_the_page(tmp_path):
+    """Jinja's autoescape: a slicer feature name holding an element with a handler reaches the page as text."""
+    planted = "<img src=x onerror=alert(1)>"
+    program = tmp_path / "planted.gcode"
+    program.write_text(tiny_print(2).replace(";TYPE:Internal infill", f";TYPE:{planted}"))
+    rows = write_reports([program], tmp_path / "out", options=ReportOptions(pdf=False))
+    page = (tmp_path / "out" / rows[0]["html"]).read_text()
+    assert "&lt;img src=x onerror=alert(1)&gt;" in page  # the breakdown's row label
+    images = re.findall(r"<img\b[^>]*>", page, flags=re.IGNORECASE)
+    assert images and all('src="data:image/png;base64,' in tag for tag in images)  # only the figures
+    assert "onerror" not in "".join(images)
 
 
 def test_empty_program_gets_a_page_without_pictures(tmp_path):

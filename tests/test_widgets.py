@@ -15,7 +15,7 @@ import gcodekit  # noqa: E402
 from gcodekit.analysis import layers as waypoint_layers  # noqa: E402
 from gcodekit.widgets import LayerViewer, StageDiff, VelocityPlot  # noqa: E402
 from gcodekit.widgets.checks import check  # noqa: E402
-from gcodekit.widgets.toolpath import Toolpath  # noqa: E402
+from gcodekit.view import Toolpath  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CUBE = ROOT / "examples" / "cube20_prusaslicer_marlin.gcode"
@@ -165,12 +165,12 @@ def test_screenshot_follows_the_browsers_camera(cube):
     viewer = LayerViewer(cube)
     viewer.layers.value = (30, 30)
     viewer.view.camera = {"azimuth": -90.0, "elevation": 89.9, "zoom": 1.0, "target": [0.0, 0.0, 0.0]}  # from above
-    image = viewer.screenshot()[int(600 * 0.07):, :560]  # below the title, left of the legend
+    image = viewer.screenshot()[int(600 * 0.07):, :620]  # below the title, left of the legend (at 78 %)
     rows, cols = np.flatnonzero(ink(image).any(axis=1)), np.flatnonzero(ink(image).any(axis=0))
     # layer 30 of the cube from above: a 20 mm square (its perimeters), as wide as it is tall
     assert rows[-1] - rows[0] == pytest.approx(cols[-1] - cols[0], abs=3)
     viewer.view.camera = {"azimuth": -90.0, "elevation": 89.9, "zoom": 2.0, "target": [0.0, 0.0, 0.0]}
-    zoomed = viewer.screenshot()[int(600 * 0.07):, :560]
+    zoomed = viewer.screenshot()[int(600 * 0.07):, :620]
     assert np.ptp(np.flatnonzero(ink(zoomed).any(axis=0))) == pytest.approx(2 * (cols[-1] - cols[0]), rel=0.05)
 
 

@@ -3,6 +3,9 @@
 explore.ipynb is run; then the layer slider, the move slider, the colour
 dropdown and the stage dropdowns are used with the keyboard and the mouse as
 a person would, and each time the picture's pixels must show what was asked.
+Then a program with HTML planted in its ``;TYPE:`` comments is opened: the
+markup must show as text and run nothing, and the WebGL canvas must agree
+with the PyVista and matplotlib pictures of the same program and camera.
 """
 
 import io
@@ -60,6 +63,7 @@ def lab(tmp_path_factory):
     shutil.copytree(ROOT / "examples", root / "examples")
     with jupyter_lab(root) as url, browser_page() as page:
         open_and_run(page, url, "notebooks/explore.ipynb")
+        page.lab_url, page.lab_root = url, root
         yield page
 
 
@@ -178,3 +182,79 @@ def test_stage_dropdowns(lab):
     assert apart(before) > 200  # stage 0 in program coordinates: the boss's circle is elsewhere
     assert apart(after) < apart(before) / 5  # the same stage on both sides: one path
     assert page.console_errors == []
+
+
+# -- program text is text; the WebGL picture is the other pictures' picture ------------------------
+
+#: Markup a slicer comment could carry: run, it would set a flag on the page or add an element to it.
+PLANTED = ("<img src=x onerror=window.gkPlanted=1>", "<b id=gk-planted>bold</b>")
+
+
+def planted_program(layers: int = 5) -> str:
+    """A 20 mm square tower, 2 mm a layer, whose two features are named by markup (and its last line ends
+    with markup in a comment: the line the source panel shows)."""
+    lines = ["M83", "G21 G90", "G1 Z2 F600"]
+    for k in range(layers):
+        z = 2.0 * (k + 1)
+        lines += [";LAYER_CHANGE", f";Z:{z:g}", f"G1 Z{z:g} F600", "G0 X0 Y0 F6000", f";TYPE:{PLANTED[0]}",
+                  "G1 X20 Y0 E1 F1800", "G1 X20 Y20 E1", "G1 X0 Y20 E1", "G1 X0 Y0 E1", "G0 X5 Y10",
+                  f";TYPE:{PLANTED[1]}", "G2 X15 Y10 I5 J0 E1"]
+    lines[-1] += " ; <img src=x onerror=window.gkPlanted=2>"
+    return "\n".join(lines) + "\n"
+
+
+def test_planted_markup_is_text_and_the_canvas_agrees(lab):
+    import json
+    import sys
+
+    import gcodekit
+    from gcodekit import visualize
+    from gcodekit.view import Toolpath, coloring
+    from gcodekit.widgets.picture import new_figure, to_rgb
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from picture_compare import agreement
+
+    page, root = lab, lab.lab_root
+    (root / "planted.gcode").write_text(planted_program())
+    op = gcodekit.gcode_to_operation(root / "planted.gcode")
+    path = Toolpath.of(op)
+    camera = visualize.fitted_camera("iso", path, 1.0)
+    cell = ("import gcodekit\nfrom gcodekit.widgets import LayerViewer\n"
+            "viewer = LayerViewer('planted.gcode', color_by='feature', height=420)\n"
+            f"viewer.view.camera = {camera.as_dict()!r}\nviewer")
+    notebook = {"cells": [{"cell_type": "code", "metadata": {}, "execution_count": None, "outputs": [],
+                           "source": cell}],
+                "metadata": {"kernelspec": {"name": "python3", "display_name": "Python 3", "language": "python"}},
+                "nbformat": 4, "nbformat_minor": 5}
+    (root / "planted.ipynb").write_text(json.dumps(notebook))
+    open_and_run(page, page.lab_url, "planted.ipynb")
+    area = page.locator(".jp-NotebookPanel:not(.lm-mod-hidden) .jp-OutputArea-child:has(.gcodekit-viewer)")
+    legend = area.locator(".gk-legend")
+    legend.locator(".gk-category").nth(1).wait_for(timeout=60_000)
+    page.wait_for_timeout(500)
+
+    # nothing ran, no element was made: the names are the legend's text, character for character
+    assert page.evaluate("window.gkPlanted") is None
+    assert page.locator("#gk-planted").count() == 0
+    assert legend.locator("img, b").count() == 0
+    assert [legend.locator(".gk-category").nth(k).inner_text() for k in range(2)] == sorted(PLANTED)
+    code = area.locator(".gcodekit-code")
+    assert "<img src=x onerror=window.gkPlanted=2>" in code.inner_text() and code.locator("img").count() == 0
+    assert page.console_errors == []  # an <img src=x> made would have failed to load
+
+    # the canvas against PyVista and matplotlib, same program, colouring and camera, at the canvas's size
+    webgl = pixels(area.locator(".gcodekit-viewer canvas"))
+    height, width = webgl.shape[:2]
+    color = coloring(path, "feature")
+    pyvista = visualize.plot_operation(op, "feature", camera=camera, window_size=(width, height), scalar_bar=False,
+                                       line_width=1.0)
+    fig = new_figure((width, height))
+    ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+    ax.set_axis_off()
+    visualize.draw_toolpath(ax, path, color, camera, np.flatnonzero(path.kind == 0), work_width=0.75)
+    matplotlib_picture = to_rgb(fig)
+    for other, label in ((pyvista, "PyVista"), (matplotlib_picture, "matplotlib")):
+        result = agreement(webgl, other)
+        print(f"WebGL canvas ({width} x {height}) against {label}: {result}")
+        assert result.iou > 0.8 and result.median_angle < 8 and result.within_10 > 0.85, f"{label}: {result}"

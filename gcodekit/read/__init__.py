@@ -24,11 +24,11 @@ from ..errors import Diagnostics
 from ..syntax import Flavor, load_flavor
 from .blocks import Block, Blocks, Word
 from .scan import fast_path_possible, scan
-from .source import MAX_LINE_LENGTH, iter_lines, open_program
+from .source import MAX_LINE_LENGTH, iter_lines, open_program, program_lines
 from .tokenize import LineTokenizer, RawBlock
 
 __all__ = ["Block", "Blocks", "Word", "read_text", "read_file", "iter_blocks", "iter_lines",
-           "open_program", "read_source_lines", "iter_source_blocks", "MAX_LINE_LENGTH"]
+           "open_program", "program_lines", "read_source_lines", "iter_source_blocks", "MAX_LINE_LENGTH"]
 
 #: Preprocessed lines read into one chunk of blocks (see :func:`iter_source_blocks`)
 CHUNK_LINES = 50_000

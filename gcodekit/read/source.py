@@ -41,7 +41,7 @@ from typing import IO, Iterator, Union
 
 from ..errors import Diagnostics
 
-__all__ = ["Source", "iter_lines", "open_program", "MAX_LINE_LENGTH", "CHUNK_BYTES"]
+__all__ = ["Source", "iter_lines", "open_program", "program_lines", "MAX_LINE_LENGTH", "CHUNK_BYTES"]
 
 Source = Union[str, os.PathLike, bytes]
 CHUNK_BYTES = 256 << 10  # small chunks keep the per-chunk arrays (about 60 bytes per input byte) small
@@ -141,6 +141,18 @@ def iter_lines(source: Source, diagnostics: Diagnostics | None = None) -> Iterat
         yield from _LineSplitter(stream, diagnostics).chunks()  # type: ignore[arg-type]
     finally:
         stream.close()
+
+
+def program_lines(source: Source) -> list[str]:
+    """The program's lines as text, numbered as the pipeline numbers them (line ``k`` is item ``k - 1``).
+
+    Read by :func:`iter_lines` (every container, encoding and line end it
+    knows); bytes that are not UTF-8 show as U+FFFD.  Only ``\\n`` ends a
+    line, as in the reader (``str.splitlines`` would also cut at form feeds
+    and other separators and shift the numbers).
+    """
+    text = b"".join(iter_lines(source)).decode("utf-8", "replace")
+    return text.split("\n")[:-1] if text else []
 
 
 class _LineSplitter:

@@ -2,9 +2,13 @@
 
 Each function returns a matplotlib Figure; :func:`report_figures` draws them
 all and returns them as ``data:`` URIs so a page embeds them and works
-offline.  Large programs are thinned before drawing (every k-th layer in 3D,
-every k-th segment elsewhere, binned speeds) so a 150 k-line print draws in
-about a second: a picture 800 pixels wide cannot show more anyway.
+offline.  The toolpath pictures draw the one :class:`~gcodekit.view.Toolpath`
+with the one :class:`~gcodekit.view.Coloring` through
+:func:`gcodekit.visualize.draw_toolpath`, as the notebook viewer and the
+PyVista pictures do.  Large programs are thinned before drawing (every k-th
+layer in 3D, every k-th segment elsewhere, binned speeds) so a 150 k-line
+print draws in about a second: a picture 800 pixels wide cannot show more
+anyway.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..emulate.arcs import PLANES, sweep
+from ..view import WORK, Coloring, Toolpath, ToolpathError, coloring, default_coloring
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -26,8 +30,6 @@ if TYPE_CHECKING:
 #: Segments drawn in the 3D view and the top view (beyond this they only add ink).
 MAX_3D_SEGMENTS = 25_000
 MAX_2D_SEGMENTS = 60_000
-#: Chords per arc: 16 keeps a 100 mm arc within 0.5 mm of the circle at report scale.
-ARC_CHORDS = 16
 THUMBNAILS = 12
 #: The pictures of a report page.
 FIGURES = ("iso", "top", "layer_times", "thumbnails", "velocity", "breakdown", "part")
@@ -36,139 +38,65 @@ WIDTH_IN = 8.0
 
 
 @dataclass
-class Segments:
-    """Straight pieces of the toolpath, with what colours them.
+class Drawing:
+    """What a report draws of a toolpath: the toolpath, its colouring and which of its segments.
 
-    ``start``/``end`` (n, 3) mm; ``value`` a category index (``labels``) or a
-    speed in mm/s (``labels`` None); ``layer`` per segment (-1 without layers);
-    ``rapid`` True for rapid (or additive travel) moves.
+    A print shows its deposition only; a mill program every move, rapids grey.
     """
 
-    start: np.ndarray
-    end: np.ndarray
-    value: np.ndarray
-    layer: np.ndarray
-    rapid: np.ndarray
-    labels: list[str] | None
+    path: Toolpath
+    color: Coloring
+    segments: np.ndarray
 
-    def take(self, keep: np.ndarray) -> "Segments":
-        return Segments(self.start[keep], self.end[keep], self.value[keep], self.layer[keep], self.rapid[keep],
-                        self.labels)
+    @property
+    def layer(self) -> np.ndarray:
+        """Layer of each segment drawn (-1 for a program without layers)."""
+        if self.path.group_by != "layer":
+            return np.full(self.segments.size, -1)
+        return self.path.segment_group[self.segments]
 
+    @property
+    def start(self) -> np.ndarray:
+        return self.path.start[self.segments]
 
-def toolpath_segments(op: "Operation") -> Segments:
-    """The moves of an operation as straight segments, arcs split into chords.
+    @property
+    def end(self) -> np.ndarray:
+        return self.path.end[self.segments]
 
-    Additive programs keep only the depositing moves, coloured by slicer
-    feature when the program names them; others keep every move, coloured by
-    commanded speed, with rapids flagged.
-    """
-    w = op.waypoints
-    additive = op.process == "additive"
-    xyz = np.column_stack([w["x"], w["y"], w["z"]]).astype(float)
-    prev = np.vstack([xyz[:1], xyz[:-1]])
-    keep = op.depositing if additive else op.moving
-    idx = np.flatnonzero(keep)
-    labels = None
-    if additive:
-        names = op.features
-        if np.any(names != ""):
-            labels, value = np.unique(names, return_inverse=True)
-            labels = [str(x) or "(no feature)" for x in labels]
-        else:
-            value = np.asarray(w["feed"], float) / 60.0
-        layer = op.layers
-    else:
-        value = np.asarray(w["feed"], float) / 60.0
-        layer = np.full(xyz.shape[0], -1)
-    start, end = prev[idx], xyz[idx]
-    owner = idx
-    arcs = np.isin(np.asarray(w["motion"])[idx], (3, 4))
-    if arcs.any():
-        a = idx[arcs]
-        pts = _arc_points(w, a, prev[a], xyz[a])  # (m, ARC_CHORDS + 1, 3)
-        arc_start = pts[:, :-1].reshape(-1, 3)
-        arc_end = pts[:, 1:].reshape(-1, 3)
-        straight = idx[~arcs]
-        start = np.vstack([prev[straight], arc_start])
-        end = np.vstack([xyz[straight], arc_end])
-        owner = np.r_[straight, np.repeat(a, ARC_CHORDS)]
-        order = np.argsort(owner, kind="stable")
-        start, end, owner = start[order], end[order], owner[order]
-    rapid = np.asarray(w["motion"])[owner] == 1
-    return Segments(start, end, np.asarray(value)[owner], np.asarray(layer)[owner], rapid, labels)
+    def take(self, keep: np.ndarray) -> "Drawing":
+        return Drawing(self.path, self.color, self.segments[keep])
 
 
-def _arc_points(w: dict, rows: np.ndarray, start: np.ndarray, end: np.ndarray) -> np.ndarray:
-    """Points along the arcs ending at waypoints ``rows`` (plane from ``plane``, centre
-    ``cx, cy, cz``), the helix axis interpolated."""
-    motion = np.asarray(w["motion"])
-    center = np.column_stack([w["cx"], w["cy"], w["cz"]]).astype(float)[rows]
-    plane = np.asarray(w["plane"])[rows]
-    out = np.empty((rows.size, ARC_CHORDS + 1, 3))
-    f = np.linspace(0.0, 1.0, ARC_CHORDS + 1)
-    for code, ((i, j, h), _) in PLANES.items():
-        sel = plane == code
-        if not sel.any():
-            continue
-        s, e, c = start[sel], end[sel], center[sel]
-        cw = motion[rows][sel] == 3
-        angle = sweep(s[:, [i, j]], e[:, [i, j]], c[:, [i, j]], cw, np.ones(sel.sum()))
-        a0 = np.arctan2(s[:, j] - c[:, j], s[:, i] - c[:, i])
-        r = np.hypot(s[:, i] - c[:, i], s[:, j] - c[:, j])
-        theta = a0[:, None] + np.where(cw, -1.0, 1.0)[:, None] * angle[:, None] * f
-        out[sel, :, i] = c[:, i, None] + r[:, None] * np.cos(theta)
-        out[sel, :, j] = c[:, j, None] + r[:, None] * np.sin(theta)
-        out[sel, :, h] = s[:, h, None] + (e[:, h] - s[:, h])[:, None] * f
-    return out
+def toolpath_drawing(op: "Operation", color_by: str | None = None) -> Drawing | None:
+    """The report's drawing of ``op``, coloured by ``color_by`` (default: features, layers or feed); None
+    when nothing moves."""
+    try:
+        path = Toolpath.of(op)
+    except ToolpathError:
+        return None
+    color = coloring(path, color_by or default_coloring(op))
+    keep = path.kind == WORK if op.process == "additive" else np.ones(path.n_segments, bool)
+    return Drawing(path, color, np.flatnonzero(keep))
 
 
-def _thin(seg: Segments, limit: int, by_layer: bool) -> Segments:
+def _thin(drawing: Drawing, limit: int, by_layer: bool) -> Drawing:
     """At most about ``limit`` segments: every k-th layer when layered, else every k-th segment."""
-    n = seg.start.shape[0]
+    n = drawing.segments.size
     if n <= limit:
-        return seg
-    if by_layer and (seg.layer >= 0).any():
-        ids = np.unique(seg.layer[seg.layer >= 0])
+        return drawing
+    layer = drawing.layer
+    if by_layer and (layer >= 0).any():
+        ids = np.unique(layer[layer >= 0])
         step = int(np.ceil(n / limit))
         chosen = ids[::step]
         if chosen[-1] != ids[-1]:
             chosen = np.r_[chosen, ids[-1]]  # keep the top layer: it is what the part looks like
-        kept = seg.take(np.isin(seg.layer, chosen))
-        if kept.start.shape[0] <= 2 * limit:
+        kept = drawing.take(np.isin(layer, chosen))
+        if kept.segments.size <= 2 * limit:
             return kept
-        seg = kept
-        n = seg.start.shape[0]
-    return seg.take(np.arange(0, n, int(np.ceil(n / limit))))
-
-
-def _colours(seg: Segments):
-    """RGBA per segment and what to put in a legend or colour bar."""
-    import matplotlib as mpl
-
-    if seg.labels is not None:
-        cmap = mpl.colormaps["tab10" if len(seg.labels) <= 10 else "tab20"]
-        return cmap(seg.value.astype(int) % cmap.N), ("legend", [(lab, cmap(k % cmap.N))
-                                                                 for k, lab in enumerate(seg.labels)])
-    finite = seg.value[np.isfinite(seg.value) & ~seg.rapid]
-    hi = float(np.percentile(finite, 99)) if finite.size else 1.0
-    lo = float(finite.min()) if finite.size else 0.0
-    norm = mpl.colors.Normalize(lo, hi if hi > lo else lo + 1.0)
-    colours = mpl.colormaps["viridis"](norm(np.nan_to_num(seg.value)))
-    colours[seg.rapid] = (0.6, 0.6, 0.6, 0.5)
-    return colours, ("colorbar", mpl.cm.ScalarMappable(norm=norm, cmap="viridis"))
-
-
-def _key(fig: "Figure", ax, key, seg: Segments) -> None:
-    kind, what = key
-    shown = set(np.unique(seg.value).astype(int).tolist()) if kind == "legend" else set()
-    if kind == "legend":
-        from matplotlib.lines import Line2D
-
-        handles = [Line2D([], [], color=c, lw=3, label=lab) for k, (lab, c) in enumerate(what) if k in shown]
-        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
-    else:
-        fig.colorbar(what, ax=ax, shrink=0.7, pad=0.08, label="commanded speed, mm/s")
+        drawing = kept
+        n = drawing.segments.size
+    return drawing.take(np.arange(0, n, int(np.ceil(n / limit))))
 
 
 def _figure(height: float, **margins: float) -> "Figure":
@@ -184,89 +112,68 @@ def _figure(height: float, **margins: float) -> "Figure":
     return fig
 
 
-def toolpath_iso(seg: Segments) -> "Figure":
-    """Isometric 3D view of the toolpath (orthographic, equal axes).
+def toolpath_iso(drawing: Drawing) -> "Figure":
+    """The toolpath seen by the ``iso`` camera (orthographic, from +X, -Y, +Z), as the viewer shows it."""
+    from ..visualize import add_legend, draw_toolpath, fitted_camera
 
-    A print shows its layers only: a purge line drawn before the first layer
-    would otherwise shrink the part to a corner of the picture (the top view
-    shows it).
-    """
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection
-
-    if (seg.layer >= 0).any():
-        seg = seg.take(seg.layer >= 0)
-    seg = _thin(seg, MAX_3D_SEGMENTS, by_layer=True)
-    fig = _figure(5.0, left=0.0, right=0.8, bottom=0.02, top=1.0)
-    ax = fig.add_subplot(projection="3d", proj_type="ortho")
-    colours, key = _colours(seg)
-    ax.add_collection3d(Line3DCollection(np.stack([seg.start, seg.end], axis=1), colors=colours, linewidths=0.6))
-    lo = np.minimum(seg.start.min(axis=0), seg.end.min(axis=0)) if len(seg.start) else np.zeros(3)
-    hi = np.maximum(seg.start.max(axis=0), seg.end.max(axis=0)) if len(seg.start) else np.ones(3)
-    span = np.maximum(hi - lo, 1e-3 * max(float((hi - lo).max()), 1.0))
-    ax.set_xlim(lo[0], lo[0] + span[0])
-    ax.set_ylim(lo[1], lo[1] + span[1])
-    ax.set_zlim(lo[2], lo[2] + span[2])
-    # equal scales, except that a flat part (a mill pass, a first layer) keeps a readable height
-    ax.set_box_aspect((span[0], span[1], max(span[2], 0.25 * max(span[0], span[1]))))
-    from matplotlib.ticker import MaxNLocator
-
-    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
-        axis.set_major_locator(MaxNLocator(6))
-    ax.view_init(elev=35.264, azim=-45)  # isometric: arctan(1/sqrt 2) above the XY diagonal
-    ax.set_xlabel("X, mm")
-    ax.set_ylabel("Y, mm")
-    ax.set_zlabel("Z, mm")
-    ax.tick_params(labelsize=7)
-    _key(fig, ax, key, seg)
+    drawing = _thin(drawing, MAX_3D_SEGMENTS, by_layer=True)
+    fig = _figure(5.0)
+    ax = fig.add_axes((0.0, 0.0, 0.78, 1.0))
+    ax.set_axis_off()
+    camera = fitted_camera("iso", drawing.path, 0.78 * WIDTH_IN / 5.0)
+    vmin, vmax = draw_toolpath(ax, drawing.path, drawing.color, camera, drawing.segments,
+                               work_width=0.6, travel_width=0.5)
+    add_legend(fig, drawing.color, drawing.path, drawing.segments, vmin, vmax)
     return fig
 
 
-def toolpath_top(seg: Segments) -> "Figure":
-    """Top view (XY) of the whole toolpath."""
-    from matplotlib.collections import LineCollection
+def toolpath_top(drawing: Drawing) -> "Figure":
+    """Top view (XY) of the whole toolpath, axes in machine millimetres."""
+    from ..visualize import add_legend, draw_toolpath, fitted_camera
 
-    seg = _thin(seg, MAX_2D_SEGMENTS, by_layer=False)
-    fig = _figure(4.6, left=0.09, right=0.8, bottom=0.1, top=0.93)
-    ax = fig.add_subplot()
-    colours, key = _colours(seg)
-    ax.add_collection(LineCollection(np.stack([seg.start[:, :2], seg.end[:, :2]], axis=1), colors=colours,
-                                     linewidths=0.5))
-    ax.autoscale()
-    ax.set_aspect("equal")
+    drawing = _thin(drawing, MAX_2D_SEGMENTS, by_layer=False)
+    fig = _figure(4.6)
+    ax = fig.add_axes((0.09, 0.1, 0.69, 0.83))
+    camera = fitted_camera("top", drawing.path, 0.69 * WIDTH_IN / (0.83 * 4.6))
+    vmin, vmax = draw_toolpath(ax, drawing.path, drawing.color, camera, drawing.segments,
+                               work_width=0.5, travel_width=0.5, absolute=True)
+    ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("X, mm")
     ax.set_ylabel("Y, mm")
     ax.set_title("Top view", fontsize=10)
-    _key(fig, ax, key, seg)
+    add_legend(fig, drawing.color, drawing.path, drawing.segments, vmin, vmax)
     return fig
 
 
-def layer_thumbnails(seg: Segments, count: int = THUMBNAILS) -> "Figure | None":
+def layer_thumbnails(drawing: Drawing, count: int = THUMBNAILS) -> "Figure | None":
     """Small XY views of ``count`` layers spread over the height, on the part's extents."""
     from matplotlib.collections import LineCollection
 
-    ids = np.unique(seg.layer[seg.layer >= 0])
+    layer = drawing.layer
+    ids = np.unique(layer[layer >= 0])
     if ids.size == 0:
         return None
     chosen = ids[np.unique(np.linspace(0, ids.size - 1, min(count, ids.size)).round().astype(int))]
     cols = 6
     rows = int(np.ceil(chosen.size / cols))
     fig = _figure(1.45 * rows + 0.2, left=0.01, right=0.99, bottom=0.02, top=0.92, wspace=0.08, hspace=0.25)
-    colours, _ = _colours(seg)
-    layered = seg.layer >= 0  # the extents of the layers, not of a purge line drawn before them
-    lo, hi = seg.start[layered, :2].min(axis=0), seg.start[layered, :2].max(axis=0)
+    colours, _, _ = drawing.color.segment_rgb(drawing.path, drawing.segments)
+    start, end = drawing.start, drawing.end
+    layered = layer >= 0  # the extents of the layers, not of a purge line drawn before them
+    lo, hi = start[layered, :2].min(axis=0), start[layered, :2].max(axis=0)
     pad = 0.03 * max(float((hi - lo).max()), 1.0)
     lo, hi = lo - pad, hi + pad
-    for k, layer in enumerate(chosen):
+    for k, one in enumerate(chosen):
         ax = fig.add_subplot(rows, cols, k + 1)
-        sel = seg.layer == layer
-        ax.add_collection(LineCollection(np.stack([seg.start[sel, :2], seg.end[sel, :2]], axis=1),
+        sel = layer == one
+        ax.add_collection(LineCollection(np.stack([start[sel, :2], end[sel, :2]], axis=1),
                                          colors=colours[sel], linewidths=0.4))
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
         ax.set_aspect("equal")
         ax.set_xticks([])
         ax.set_yticks([])
-        ax.set_title(f"layer {int(layer)}", fontsize=7)
+        ax.set_title(f"layer {int(one)}", fontsize=7)
     return fig
 
 
@@ -372,14 +279,14 @@ def report_figures(op: "Operation", data: dict[str, Any]) -> dict[str, str]:
     import matplotlib
 
     matplotlib.use("Agg", force=False)  # off-screen even when a display is set
-    seg = toolpath_segments(op)
+    drawing = toolpath_drawing(op)
     figures: dict[str, Any] = dict.fromkeys(FIGURES)
-    if seg.start.shape[0]:
-        figures["iso"] = toolpath_iso(seg)
-        figures["top"] = toolpath_top(seg)
+    if drawing is not None and drawing.segments.size:
+        figures["iso"] = toolpath_iso(drawing)
+        figures["top"] = toolpath_top(drawing)
     if data["layers"]:
         figures["layer_times"] = layer_times(data["layers"], data.get("slicer_layers") or [])
-        figures["thumbnails"] = layer_thumbnails(seg) if seg.start.shape[0] else None
+        figures["thumbnails"] = layer_thumbnails(drawing) if drawing is not None and drawing.segments.size else None
     figures["velocity"] = velocity(op)
     figures["breakdown"] = breakdown_chart(data["breakdown"])
     uris = {name: None if fig is None else data_uri(fig) for name, fig in figures.items()}

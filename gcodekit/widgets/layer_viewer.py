@@ -17,10 +17,10 @@ import ipywidgets as widgets
 import numpy as np
 import traitlets
 
-from .coloring import Coloring, choices, colormap_table, coloring, palette_rgb
+from ..view import Camera, Coloring, Toolpath, ToolpathError, choices, coloring, source_lines
 from .display import PictureDisplay, friendly, message_html
-from .picture import Camera, message_figure, toolpath_figure
-from .toolpath import Toolpath, ToolpathError, source_lines
+from .picture import message_figure, toolpath_figure
+from .toolpath import load_toolpath
 
 #: Source lines shown around the current one.
 CONTEXT_LINES = 6
@@ -95,7 +95,7 @@ class LayerViewer(PictureDisplay):
         self.camera = Camera()
         self._lines: list[str] | None = None
         try:
-            self.path = Toolpath.of(source, group_by)
+            self.path = load_toolpath(source, group_by)
         except ToolpathError as exc:
             self.error = str(exc)
         except Exception as exc:  # anything the reader raised: a message in the widget, not a traceback
@@ -166,13 +166,9 @@ class LayerViewer(PictureDisplay):
 
     def _recolor(self) -> None:
         self._coloring = color = coloring(self.path, self.color_by.value)
-        if color.categories is not None:
-            table = np.round(palette_rgb(len(color.categories)) * 255).astype(np.uint8)
-        else:
-            table = colormap_table()
         with self.view.hold_sync():
             self.view.values = color.values.astype(np.float32).tobytes()
-            self.view.palette = table.tobytes()
+            self.view.palette = color.table().tobytes()
             self.view.categories = color.categories or []
             self.view.title = color.title
 

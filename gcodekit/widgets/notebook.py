@@ -8,10 +8,19 @@ programs the transpiler's stages in a :class:`StageDiff`.
 
 from __future__ import annotations
 
+import html
 import os
+import re
 from pathlib import Path
 
 from ..limits import MAX_ITERATIONS, MAX_MOTIONS
+
+_MARKDOWN_PUNCTUATION = re.compile(r"([\\`*_{}\[\]()#+\-.!|~])")
+
+
+def markdown_text(text: str) -> str:
+    """``text`` as Markdown that shows it literally: no HTML, no emphasis, no links."""
+    return _MARKDOWN_PUNCTUATION.sub(r"\\\1", html.escape(text, quote=False))
 
 
 def exploration_notebook(program: str | os.PathLike, *, machine: str | None = None,
@@ -35,8 +44,8 @@ def exploration_notebook(program: str | os.PathLike, *, machine: str | None = No
     config = where(machine_config) if machine_config else None
     name = Path(program).name
     cells = [
-        new_markdown_cell(f"# {name}\n\nWritten by `gcodekit notebook`: the program read and emulated, its tables "
-                          "and the widgets wired to it. Run all cells (a kernel with `gcodekit[widgets]`)."),
+        new_markdown_cell(f"# {markdown_text(name)}\n\nWritten by `gcodekit notebook`: the program read and "
+                          "emulated, its tables and the widgets wired to it. Run all cells (a kernel with `gcodekit[widgets]`)."),
         # repr() writes the values as Python literals: a file name cannot become code
         new_code_cell(f"program = {where(program)!r}\nmachine = {machine!r}\nmachine_config = {config!r}\n"
                       f"max_motions = {int(max_motions)!r}\nmax_iterations = {int(max_iterations)!r}",

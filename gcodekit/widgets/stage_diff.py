@@ -259,7 +259,7 @@ class StageDiff(PictureDisplay):
         return f'<div class="gcodekit-diff-summary" style="font:12px sans-serif;margin:4px 0">{note}</div>' + "".join(out)
 
     def _source_lines(self) -> list[str]:
-        from .toolpath import source_lines
+        from ..view import source_lines
 
         return source_lines(self.transpiler.op) or []
 
@@ -334,11 +334,11 @@ class StageDiff(PictureDisplay):
                 return message_figure(f"{side.name}: cannot draw its toolpath: {friendly(exc)}")
             w = op.waypoints
             motion = np.asarray(w["motion"])
-            rows = np.flatnonzero((motion > 0) & (np.asarray(w["distance"]) > 0))
-            rows = rows[rows > 0]
-            from .toolpath import _segments
+            from ..view import move_segments
 
-            start, end, move_of = _segments(w, rows)
+            rows = np.flatnonzero(op.moving)
+            rows = rows[rows > 0]  # a move runs from the waypoint before it
+            start, end, move_of = move_segments(w, rows)
             if shift is not None:
                 start, end = start - shift[rows][move_of], end - shift[rows][move_of]
             rapid = motion[rows][move_of] == 1
@@ -387,9 +387,7 @@ def _frame(header: str) -> str:
 def _source_numbers(op, lines: list[str]) -> np.ndarray:
     """The source line (N-number) of each waypoint of ``op``, emulated from ``lines``; -1 where none."""
     numbers = np.array([key[1] if key[0] == "N" else -1 for key in map(source_key, lines)] + [-1])
-    from .toolpath import _command_rows
-
-    text_line = np.asarray(op.table.line, np.int64)[_command_rows(op)] - 1
+    text_line = np.asarray(op.table.line, np.int64)[op.waypoints["command"]] - 1
     return numbers[np.clip(text_line, 0, len(lines))]
 
 

@@ -124,9 +124,7 @@ def path_points(op: "Operation", kinds: Iterable[int] = (FEED, ARC_CW, ARC_CCW),
 
 
 def _line(op: "Operation", row: int) -> int:
-    from .toolpath import _command_rows
-
-    return int(op.table.line[_command_rows(op)[row]])
+    return int(op.table.line[op.waypoints["command"][row]])
 
 
 def _xyz(point) -> str:
@@ -185,12 +183,12 @@ def passes_through(points: Sequence[Sequence[float]], *, cutting: bool = True, t
     kinds = (FEED, ARC_CW, ARC_CCW) if cutting else (RAPID, FEED, ARC_CW, ARC_CCW)
 
     def test(op, source):
-        from .toolpath import _segments
+        from ..view import move_segments
 
         rows = _moves(op, kinds)
         missed = list(points)
         if rows.size:
-            start, end, _ = _segments(op.waypoints, rows)
+            start, end, _ = move_segments(op.waypoints, rows)
             missed = [p for p in points if _distance_to_segments(np.asarray(p, float), start, end) > tolerance]
         if not missed:
             return None

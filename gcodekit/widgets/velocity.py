@@ -19,7 +19,8 @@ import traitlets
 
 from .display import PictureDisplay, friendly, message_html
 from .picture import message_figure, new_figure
-from .toolpath import Toolpath, ToolpathError, source_lines
+from ..view import Toolpath, ToolpathError, source_lines
+from .toolpath import load_toolpath
 
 #: Bins of the envelope: about one per pixel of a notebook-wide plot.
 BINS = 1200
@@ -83,7 +84,7 @@ class VelocityPlot(PictureDisplay):
         self.view = VelocityView(height=height, x_label=X_LABELS[x], layout=widgets.Layout(width="100%"))
         self.picked = widgets.HTML()
         try:
-            self.path = Toolpath.of(op)
+            self.path = load_toolpath(op)
             self._profile()
         except ToolpathError as exc:
             self.error = str(exc)

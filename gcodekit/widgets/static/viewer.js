@@ -37,7 +37,7 @@ void main() {
   if (u_solid > 0.5) { gl_FragColor = u_color; return; }
   if (v_kind > 0.5) {
     if (u_travel < 0.5) discard;
-    gl_FragColor = vec4(0.6, 0.6, 0.6, 1.0);
+    gl_FragColor = vec4(0.604, 0.604, 0.604, 1.0); // TRAVEL_COLOR, #9a9a9a (gcodekit/view/coloring.py)
     return;
   }
   gl_FragColor = vec4(texture2D(u_cmap, vec2(v_t, 0.5)).rgb, 1.0);
@@ -215,19 +215,31 @@ function render({ model, el }) {
     return "#" + [r, g, b].map((v) => v.toString(16).padStart(2, "0")).join("");
   }
 
+  // every text here comes from the program (a slicer's ;TYPE: names) or the kernel: it is set as
+  // text, never parsed as HTML
+  function element(tag, css, text) {
+    const node = document.createElement(tag);
+    if (css) node.style.cssText = css;
+    if (text !== undefined) node.textContent = text;
+    return node;
+  }
+
   function drawLegend(s, vmin, vmax, present) {
-    const title = `<div style="font-weight:600;margin-bottom:2px">${model.get("title")}</div>`;
+    const nodes = [element("div", "font-weight:600;margin-bottom:2px", model.get("title"))];
     const cats = model.get("categories") || [];
     const p = state.palette;
     if (cats.length) {
-      const rows = [];
       for (let k = 0; k < cats.length; k++) {
         if (!present[k]) continue;
         const j = (k % (p.length / 3)) * 3;
-        rows.push(`<div><span style="display:inline-block;width:10px;height:10px;margin-right:4px;` +
-          `background:${hex(p[j], p[j + 1], p[j + 2])}"></span>${cats[k]}</div>`);
+        const swatch = element("span", "display:inline-block;width:10px;height:10px;margin-right:4px");
+        swatch.style.background = hex(p[j], p[j + 1], p[j + 2]);
+        const row = element("div");
+        row.className = "gk-category";
+        row.append(swatch, element("span", "", String(cats[k])));
+        nodes.push(row);
       }
-      legend.innerHTML = title + rows.join("");
+      legend.replaceChildren(...nodes);
       return;
     }
     const stops = [];
@@ -236,11 +248,15 @@ function render({ model, el }) {
       stops.push(hex(p[j], p[j + 1], p[j + 2]));
     }
     const fmt = (v) => (Math.abs(v) >= 100 ? v.toFixed(0) : Math.abs(v) >= 1 ? v.toFixed(1) : v.toPrecision(2));
-    legend.innerHTML = title +
-      `<div style="display:flex;align-items:stretch;gap:4px"><div style="width:12px;height:120px;` +
-      `background:linear-gradient(to top,${stops.join(",")})"></div><div style="display:flex;flex-direction:column;` +
-      `justify-content:space-between"><span>${fmt(vmax)}</span><span>${fmt((vmin + vmax) / 2)}</span>` +
-      `<span>${fmt(vmin)}</span></div></div>`;
+    const bar = element("div", "width:12px;height:120px");
+    bar.style.background = `linear-gradient(to top,${stops.join(",")})`;
+    const ticks = element("div", "display:flex;flex-direction:column;justify-content:space-between");
+    ticks.append(element("span", "", fmt(vmax)), element("span", "", fmt((vmin + vmax) / 2)),
+      element("span", "", fmt(vmin)));
+    const scale = element("div", "display:flex;align-items:stretch;gap:4px");
+    scale.append(bar, ticks);
+    nodes.push(scale);
+    legend.replaceChildren(...nodes);
   }
 
   function draw() {

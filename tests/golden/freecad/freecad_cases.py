@@ -1,4 +1,4 @@
-"""Scripted FreeCAD Path API sequences: run on FreeCAD 0.20.2 by regenerate.py, on gcodekit.path by the tests.
+"""Scripted FreeCAD Path API sequences: run on FreeCAD 0.20.2 by regenerate_freecad.py, on gcodekit.path by the tests.
 
 Each case is a snippet that sets ``result``.  It sees ``Path`` (FreeCAD's
 module or ``gcodekit.path``), ``App`` (``FreeCAD`` or ``gcodekit.path``, for

@@ -4,7 +4,7 @@
 Run with Debian's FreeCAD (``apt-get install freecad-python3``) and its
 interpreter:
 
-    /usr/bin/python3 tests/golden/freecad/regenerate.py
+    /usr/bin/python3 tests/golden/freecad/regenerate_freecad.py
 
 Each case runs in a forked child with a clean HOME, because FreeCAD 0.20.2
 aborts the whole process on some inputs (recorded as ``{"abort": signal}``).
@@ -81,7 +81,7 @@ def main():
            "same": lambda p: [p.Length, box(p)]}
     version = ".".join(FreeCAD.Version()[:3])
     answers = {name: run(code, env) for name, code in CASES.items()}
-    out = {"freecad": version, "generated_by": "tests/golden/freecad/regenerate.py", "cases": answers}
+    out = {"freecad": version, "generated_by": "tests/golden/freecad/regenerate_freecad.py", "cases": answers}
     (HERE / "api.json").write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
     print(f"FreeCAD {version}: {len(answers)} cases, "
           f"{sum('abort' in a for a in answers.values())} aborts, {sum('error' in a for a in answers.values())} errors")
