@@ -211,7 +211,7 @@ def test_fusion_and_laser_times_are_not_invented(read_all, realworld):
 
 
 def test_laser_power_is_a_column_and_a_colouring(read_all):
-    from gcodekit.visualize import waypoint_scalars
+    from gcodekit.view.coloring import waypoint_scalars
 
     op = read_all["lightburn_0.9.24_g2_lens.nc"][0]
     power = op.waypoints["power"]
