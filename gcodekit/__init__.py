@@ -46,7 +46,7 @@ from .pipeline import (
     parse_program,
     transpile_program,
 )
-from .plan.profile import BAAMMotionProfile, MotionProfile
+from .plan.motion_profile import BAAMMotionProfile, MotionProfile
 from .schema import COLUMNS
 from .syntax import detect_flavor, list_flavors, load_flavor
 

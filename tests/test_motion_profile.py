@@ -14,7 +14,7 @@ import gcodekit
 from gcodekit.errors import ConfigError
 from gcodekit.plan import planner_settings
 from gcodekit.plan.moves import PlannerMoves
-from gcodekit.plan.profile import BAAMMotionProfile, MotionProfile
+from gcodekit.plan.motion_profile import BAAMMotionProfile, MotionProfile
 from gcodekit.plan.shapes import ConstantVelocity, LinearRamp, SCurve, Trapezoid
 
 

@@ -29,7 +29,7 @@ PLANNERS = {
     "marlin": ("gcodekit.plan.marlin", "MarlinConfig", "from_m503"),
     "grbl": ("gcodekit.plan.grbl", "GrblConfig", "from_settings"),
     "reprapfirmware": ("gcodekit.plan.reprapfirmware", "RrfConfig", "from_config_g"),
-    "motion_profile": ("gcodekit.plan.motion_profile", "MotionProfileConfig", "from_config_file"),
+    "motion_profile": ("gcodekit.plan.generic", "MotionProfileConfig", "from_config_file"),
 }
 
 
