@@ -26,7 +26,7 @@ GOLDEN = ROOT / "tests" / "golden" / "freecad"
 CORPUS = ROOT.parent / "shared" / "corpus" / "linuxcnc"
 
 sys.path.insert(0, str(GOLDEN))
-from freecad_cases import CASES, DIFFERENT  # noqa: E402
+from freecad_cases import CASES, DIFFERENT, plain  # noqa: E402
 
 sys.path.remove(str(GOLDEN))
 
@@ -41,23 +41,10 @@ ENV = {"Path": gpath, "App": gpath, "length": lambda p: p.freecad_length(), "box
        "same": lambda p: [p.Length, p.BoundBox.as_list()]}
 
 
-def _plain(value):
-    """The JSON form regenerate_freecad.py stores (objects by repr)."""
-    if isinstance(value, bool) or value is None or isinstance(value, (int, str)):
-        return value
-    if isinstance(value, float):
-        return value if math.isfinite(value) else repr(value)
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    return repr(value)
-
-
 def _run(code):
     scope = dict(ENV)
     exec(code, scope)
-    return _plain(scope["result"])
+    return plain(scope["result"])
 
 
 def _close(ours, theirs):

@@ -11,6 +11,22 @@ for paths whose exact measures equal FreeCAD's (no arcs): it is the pair
 ``(p.Length, box list)`` on both sides.
 """
 
+import math
+
+
+def plain(value):
+    """A JSON-able form of an answer: FreeCAD objects by repr, floats as floats."""
+    if isinstance(value, bool) or value is None or isinstance(value, (int, str)):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else repr(value)
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    return repr(value)
+
+
 CASES: dict[str, str] = {
     # -- commands: the seed's three ways, names and keys in either case --------------------------
     "command_empty": "result = repr(Path.Command())",

@@ -13,7 +13,6 @@ script.
 """
 
 import json
-import math
 import os
 import pathlib
 import sys
@@ -21,19 +20,8 @@ import tempfile
 
 HERE = pathlib.Path(__file__).resolve().parent
 FREECAD_LIB = "/usr/lib/freecad-python3/lib"
-
-
-def plain(value):
-    """A JSON-able form of an answer: FreeCAD objects by repr, floats as floats."""
-    if isinstance(value, bool) or value is None or isinstance(value, (int, str)):
-        return value
-    if isinstance(value, float):
-        return value if math.isfinite(value) else repr(value)
-    if isinstance(value, dict):
-        return {str(k): plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [plain(v) for v in value]
-    return repr(value)
+sys.path.insert(0, str(HERE))
+from freecad_cases import CASES, plain  # noqa: E402  (beside this script)
 
 
 def run(code, env):
@@ -69,9 +57,6 @@ def main():
     sys.path.append(FREECAD_LIB)
     import FreeCAD
     import Path
-
-    sys.path.insert(0, str(HERE))
-    from freecad_cases import CASES
 
     def box(p):
         b = p.BoundBox
