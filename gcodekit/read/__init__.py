@@ -20,9 +20,10 @@ from typing import Iterable, Iterator
 
 import numpy as np
 
-from ..errors import Diagnostics
+from ..errors import Diagnostics, MissingDependencyError, check_choice
 from ..syntax import Flavor, load_flavor
 from .blocks import Block, Blocks, Word
+from . import scan_kernel
 from .scan import fast_path_possible, scan
 from .source import MAX_LINE_LENGTH, iter_lines, open_program, program_lines
 from .tokenize import LineTokenizer, RawBlock
@@ -34,22 +35,42 @@ __all__ = ["Block", "Blocks", "Word", "read_text", "read_file", "iter_blocks", "
 CHUNK_LINES = 50_000
 
 
+#: Bytes read with the NumPy scanner before a large program switches to the compiled one (importing
+#: Numba takes about half a second, which pays off from about this size on)
+COMPILED_AFTER_BYTES = 8 << 20
+ENGINES = ("auto", "numba", "numpy")
+
+
 def iter_blocks(
     chunks: Iterable[bytes],
     flavor: Flavor,
     diagnostics: Diagnostics,
+    *,
+    engine: str = "auto",
 ) -> Iterator[Blocks]:
     """Read chunks of whole lines into :class:`Blocks`, one per chunk.
 
     Line numbers continue from chunk to chunk; block indices restart at 0 in
-    each chunk (see :meth:`Blocks.concat`).
+    each chunk (see :meth:`Blocks.concat`).  ``engine`` chooses the fast
+    path's scanner: ``"numpy"`` (:func:`.scan.scan`), ``"numba"`` (the
+    compiled loop of :mod:`.scan_kernel`; Numba must be installed) or
+    ``"auto"``: NumPy, and the compiled loop from
+    :data:`COMPILED_AFTER_BYTES` on when Numba is installed.  Both give the
+    same blocks.
     """
+    check_choice("engine", engine, ENGINES)
+    if engine == "numba" and scan_kernel.compiled() is None:
+        raise MissingDependencyError("the compiled scanner needs Numba: pip install 'gcodekit[fast]'")
     tokenizer = LineTokenizer(flavor, diagnostics)
     first_line = 0
     fast = fast_path_possible(flavor)
+    read = 0
     for data in chunks:
         if fast:
-            part = _read_fast(data, first_line, flavor, tokenizer, diagnostics)
+            compiled = engine == "numba" or (engine == "auto" and read >= COMPILED_AFTER_BYTES
+                                            and scan_kernel.compiled() is not None)
+            part = _read_fast(data, first_line, flavor, tokenizer, diagnostics, compiled)
+            read += len(data)
         else:
             part = _read_slow(data, first_line, tokenizer, diagnostics)
         first_line += data.count(b"\n")
@@ -76,9 +97,10 @@ def _tokenize(tokenizer: LineTokenizer, line: bytes, number: int, diagnostics: D
 
 
 def _read_fast(
-    data: bytes, first_line: int, flavor: Flavor, tokenizer: LineTokenizer, diagnostics: Diagnostics
+    data: bytes, first_line: int, flavor: Flavor, tokenizer: LineTokenizer, diagnostics: Diagnostics,
+    compiled: bool = False,
 ) -> Blocks:
-    s = scan(data, flavor, MAX_LINE_LENGTH)
+    s = (scan_kernel.scan_compiled if compiled else scan)(data, flavor, MAX_LINE_LENGTH)
     n = s.n_lines
     ends = np.r_[s.line_start[1:] - 1, len(data) - 1]
     raw_lines: list[int] = []
