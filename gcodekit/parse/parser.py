@@ -196,12 +196,15 @@ class GcodeParser:
             number[tr] = np.round(wv[t_words] * 10).astype(np.int32)
             keep = ~((wl[pw] == _T) & np.isin(prow, tr))
             pw, prow, pletter = pw[keep], prow[keep], pletter[keep]
-        rows = len(PARAM_LETTERS)
-        table = np.full((rows, n), np.nan)
-        table[pletter, prow] = wv[pw]
-        self._first_of_repeats(blocks, table, pw, prow, pletter, n)
-        present = np.flatnonzero(np.bincount(pletter, minlength=rows))
-        params = {PARAM_LETTERS[k]: table[k].copy() for k in present}
+        # one row of the table per letter the chunk uses
+        present = np.flatnonzero(np.bincount(pletter, minlength=len(PARAM_LETTERS)))
+        slot = np.zeros(len(PARAM_LETTERS), np.int64)
+        slot[present] = np.arange(present.size)
+        pslot = slot[pletter]
+        table = np.full((present.size, n), np.nan)
+        table[pslot, prow] = wv[pw]
+        self._first_of_repeats(blocks, table, pw, prow, pslot, present, n)
+        params = {PARAM_LETTERS[k]: table[j].copy() for j, k in enumerate(present.tolist())}
         return {
             "block": rows_blocks,
             "sub": np.zeros(n, np.int32),
@@ -210,19 +213,22 @@ class GcodeParser:
             "params": params,
         }
 
-    def _first_of_repeats(self, blocks: Blocks, table, pw, prow, pletter, n_rows) -> None:
-        """A letter given twice in a block: report it and keep the first value."""
+    def _first_of_repeats(self, blocks: Blocks, table, pw, prow, pslot, present, n_rows) -> None:
+        """A letter given twice in a block: report it and keep the first value.
+
+        ``pslot`` is each word's row of ``table``, whose rows are the letters ``present``.
+        """
         if not pw.size:
             return
-        width = len(PARAM_LETTERS)
-        counts = np.bincount(prow * width + pletter, minlength=n_rows * width)
+        width = present.size
+        counts = np.bincount(prow * width + pslot, minlength=n_rows * width)
         for key in np.flatnonzero(counts > 1).tolist():
-            row, k = divmod(key, width)
-            words = pw[(prow == row) & (pletter == k)]
-            table[k, row] = blocks.word_value[words[0]]
+            row, j = divmod(key, width)
+            words = pw[(prow == row) & (pslot == j)]
+            table[j, row] = blocks.word_value[words[0]]
             line = int(blocks.block_line[blocks.word_block[words[1]]])
             self.diagnostics.report(line, int(blocks.word_col[words[1]]),
-                                    f"more than one {PARAM_LETTERS[k]} word in the block; the first is used",
+                                    f"more than one {PARAM_LETTERS[present[j]]} word in the block; the first is used",
                                     severity="error" if self._modal else "warning")
 
     # -- compound blocks ------------------------------------------------------

@@ -119,6 +119,17 @@ class CommandTable:
             return np.full(len(self), np.nan)
         return col.dense() if isinstance(col, SparseColumn) else col
 
+    def param_at(self, letter: str, rows: np.ndarray) -> np.ndarray:
+        """The word ``letter`` of the commands ``rows`` (NaN where not given), without a dense column."""
+        col = self.params.get(letter)
+        if col is None:
+            return np.full(np.shape(rows), np.nan)
+        if not isinstance(col, SparseColumn):
+            return col[rows]
+        k = np.minimum(np.searchsorted(col.rows, rows), max(col.rows.size - 1, 0))
+        found = col.rows[k] == rows if col.rows.size else np.zeros(np.shape(rows), bool)
+        return np.where(found, col.values[k] if col.rows.size else np.nan, np.nan)
+
     def code(self, i: int) -> str:
         letter, number = int(self.letter[i]), int(self.number[i])
         if letter == ord("@"):

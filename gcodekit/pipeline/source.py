@@ -91,17 +91,18 @@ def program_blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, b
         chunks = program.chunks(diagnostics)
     if flavor.percent_delimiter:
         chunks = until_closing_percent(chunks)
-    sizes: list[int] = []
+    lines_read = [0, 0]  # lines taken from the chunks, lines handed on with blocks
 
     def counted():
         for c in chunks:
-            sizes.append(c.count(b"\n"))
+            lines_read[0] += c.count(b"\n")
             if bar is not None:
                 bar.update(len(c))
             yield c
 
-    for blocks in iter_blocks(counted(), flavor, diagnostics):
-        yield blocks, sizes[-1]
+    for blocks in iter_blocks(counted(), flavor, diagnostics):  # each holds every chunk taken so far
+        yield blocks, lines_read[0] - lines_read[1]
+        lines_read[1] = lines_read[0]
 
 
 def number_other_files(lines: Iterator, main: str, diagnostics: Diagnostics) -> Iterator:

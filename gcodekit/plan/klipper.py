@@ -152,7 +152,7 @@ def _velocity_limits(op: "EmulatedProgram", config: KlipperConfig):
     """
     t = op.table
     m204 = command_rows(op, codes=("M204",))
-    s_word, p_word, t_word = (t.param(k)[m204] for k in "SPT")
+    s_word, p_word, t_word = (t.param_at(k, m204) for k in "SPT")
     accel = np.where(np.isnan(s_word), np.fmin(p_word, t_word) * (~np.isnan(p_word) & ~np.isnan(t_word)), s_word)
     accel[~(accel > 0)] = np.nan  # Klipper ignores M204 without S (or P and T together)
     ignored = m204[np.isnan(accel)]

@@ -135,7 +135,7 @@ def speed_factor(op: "EmulatedProgram") -> np.ndarray | None:
         return None
     w = op.waypoints
     cmd = w["command"]
-    values = t.param("S")[rows] / 100.0
+    values = t.param_at("S", rows) / 100.0
     values = np.where(np.isnan(values), 1.0, values)
     k = np.searchsorted(rows, cmd, side="right") - 1
     return np.where(k >= 0, values[np.maximum(k, 0)], 1.0)
@@ -143,8 +143,10 @@ def speed_factor(op: "EmulatedProgram") -> np.ndarray | None:
 
 def in_force(moves: PlannerMoves, rows: np.ndarray, values: np.ndarray, initial: float) -> np.ndarray:
     """Per move, the last value set by a command row before the move's row."""
-    if rows.size == 0:
+    if rows.size == 0 or len(moves) == 0 or rows[0] >= moves.row[-1]:
         return np.full(len(moves), initial, dtype=float)
+    if rows[-1] < moves.row[0]:  # set before the first move (the usual place): one value for all
+        return np.full(len(moves), float(values[-1]))
     k = np.searchsorted(rows, moves.row, side="left") - 1
     return np.where(k >= 0, np.asarray(values, float)[np.maximum(k, 0)], initial)
 
@@ -157,10 +159,10 @@ def m204_in_force(op: "EmulatedProgram", moves: PlannerMoves, rows: np.ndarray,
     Marlin 2 (M204.cpp) and RepRapFirmware 3 read it this way.
     """
     t = op.table
-    s_word = t.param("S")[rows]
+    s_word = t.param_at("S", rows)
     out = {}
     for letter, (name, default) in targets.items():
-        word = t.param(letter)[rows]
+        word = t.param_at(letter, rows)
         value = np.where(np.isnan(word), s_word, word)
         given = ~np.isnan(value)
         out[name] = in_force(moves, rows[given], value[given], default)
@@ -175,10 +177,12 @@ def settings_in_force(op: "EmulatedProgram", moves: PlannerMoves, rows: np.ndarr
     per row).  Returns a number when one value holds for every move (the
     common case: the limits are set once at the top), else an array.
     """
-    values = op.table.param(letter)[rows] * scale
+    values = op.table.param_at(letter, rows) * scale
     given = ~np.isnan(values)
     if not given.any():
         return float(initial)
+    if len(moves) and rows[given][-1] < moves.row[0]:  # set once before the first move: one value
+        return float(values[given][-1])
     per_move = in_force(moves, rows[given], values[given], initial)
     return float(per_move[0]) if per_move.min() == per_move.max() else per_move
 
@@ -279,7 +283,11 @@ def _move_ends(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.nda
     half the memory of two.
     """
     before = np.maximum(idx - 1, 0)
-    chained = all(np.array_equal(col[before[1:]], col[idx[:-1]]) for col in columns)
+    # where a move's waypoint follows the previous move's, its start is that move's end; compare the rest
+    # (and every one when a column holds NaN, which equals nothing)
+    gaps = np.flatnonzero(before[1:] != idx[:-1])
+    chained = all(np.array_equal(col[before[1:][gaps]], col[idx[:-1][gaps]]) if not np.isnan(col).any() else
+                  np.array_equal(col[before[1:]], col[idx[:-1]]) for col in columns)
     if chained:
         points = np.empty((idx.size + 1, 4))
         start, end = points[:-1], points[1:]

@@ -38,6 +38,8 @@ CHUNK_LINES = 50_000
 #: Bytes read with the NumPy scanner before a large program switches to the compiled one (importing
 #: Numba takes about half a second, which pays off from about this size on)
 COMPILED_AFTER_BYTES = 8 << 20
+#: The compiled scanner reads chunks of about this size (several of the source's)
+COMPILED_CHUNK_BYTES = 2 << 20
 ENGINES = ("auto", "numba", "numpy")
 
 
@@ -56,7 +58,9 @@ def iter_blocks(
     compiled loop of :mod:`.scan_kernel`; Numba must be installed) or
     ``"auto"``: NumPy, and the compiled loop from
     :data:`COMPILED_AFTER_BYTES` on when Numba is installed.  Both give the
-    same blocks.
+    same blocks.  Chunks read by the compiled loop are joined to about
+    :data:`COMPILED_CHUNK_BYTES`: a yielded chunk holds every chunk taken
+    from ``chunks`` so far, none read ahead.
     """
     check_choice("engine", engine, ENGINES)
     if engine == "numba" and scan_kernel.compiled() is None:
@@ -65,16 +69,29 @@ def iter_blocks(
     first_line = 0
     fast = fast_path_possible(flavor)
     read = 0
+    pending: list[bytes] = []
+    waiting = 0
     for data in chunks:
-        if fast:
-            compiled = engine == "numba" or (engine == "auto" and read >= COMPILED_AFTER_BYTES
-                                            and scan_kernel.compiled() is not None)
-            part = _read_fast(data, first_line, flavor, tokenizer, diagnostics, compiled)
-            read += len(data)
-        else:
-            part = _read_slow(data, first_line, tokenizer, diagnostics)
+        compiled = fast and (engine == "numba" or (engine == "auto" and read >= COMPILED_AFTER_BYTES
+                                                  and scan_kernel.compiled() is not None))
+        read += len(data)
+        if compiled:  # the compiled loop makes no big temporaries: fewer, larger chunks for the later stages
+            pending.append(data)
+            waiting += len(data)
+            if waiting < COMPILED_CHUNK_BYTES:
+                continue
+            data, pending, waiting = b"".join(pending), [], 0
+        yield _read(data, first_line, flavor, tokenizer, diagnostics, fast, compiled)
         first_line += data.count(b"\n")
-        yield part
+    if pending:
+        yield _read(b"".join(pending), first_line, flavor, tokenizer, diagnostics, fast, True)
+
+
+def _read(data: bytes, first_line: int, flavor: Flavor, tokenizer: LineTokenizer, diagnostics: Diagnostics,
+          fast: bool, compiled: bool) -> Blocks:
+    if fast:
+        return _read_fast(data, first_line, flavor, tokenizer, diagnostics, compiled)
+    return _read_slow(data, first_line, tokenizer, diagnostics)
 
 
 def _line_text(data: bytes, start: int, end: int) -> str:
