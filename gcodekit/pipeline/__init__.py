@@ -131,18 +131,25 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
     note_weak_detection(detection, diagnostics)
     if config.process == "additive" and machine_config is None and "filament_diameter" not in machine_options:
         config = _stated_filament(program, config, diagnostics)
-    op, reading_error, machine_run = _emulated(program, fl, config, diagnostics, limits, progress)
-    if uses_compensation(op):
-        compensate(op, machine_run.tools, machine_run.comp_profile_ends)
-    if mode == "strict":
-        raise_first_run(op, program, reading_error)
-        diagnostics.extend(op.diagnostics)  # its warnings
-        op.diagnostics = diagnostics
-    if plan and config.planner:
-        settings = planner_settings(config.planner, config.planner_settings, machine_config)
-        if config.planner == "marlin" and machine_config is None:
-            settings = _with_slicer_limits(op, settings, chosen=machine is not None)
-        op.attach_plan(run_planner(op, config.planner, settings))
+    bar = progress_bar(program, progress)
+    try:
+        op, reading_error, machine_run = _emulated(program, fl, config, diagnostics, limits, bar)
+        if uses_compensation(op):
+            compensate(op, machine_run.tools, machine_run.comp_profile_ends)
+        if mode == "strict":
+            raise_first_run(op, program, reading_error)
+            diagnostics.extend(op.diagnostics)  # its warnings
+            op.diagnostics = diagnostics
+        if plan and config.planner:
+            settings = planner_settings(config.planner, config.planner_settings, machine_config)
+            if config.planner == "marlin" and machine_config is None:
+                settings = _with_slicer_limits(op, settings, chosen=machine is not None)
+            if bar is not None:
+                bar.set_postfix_str(f"planning {len(op.waypoints['x']):,} moves ({config.planner})")
+            op.attach_plan(run_planner(op, config.planner, settings))
+    finally:
+        if bar is not None:
+            bar.close()
     if config.laser and op.waypoints is not None:
         op.waypoints["power"] = laser_power(op.waypoints)
     if config.process == "additive" and config.extruder_type == "filament" and op.waypoints is not None:
@@ -204,8 +211,7 @@ def _with_slicer_limits(op: Operation, settings, chosen: bool):
     return dataclasses.replace(settings, **limits)
 
 
-def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits,
-              progress: bool):
+def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits, bar):
     """Read, parse and emulate the program chunk by chunk into one Operation.
 
     Returns the operation, the reading error strict mode holds back (the
@@ -219,7 +225,6 @@ def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: 
     machine_diagnostics.elsewhere = diagnostics.elsewhere
     m = new_machine(fl, config, machine_diagnostics, limits)
     tables, waypoints, n_lines = [], [], 0
-    bar = progress_bar(program, progress)
 
     def emulate(blocks: Blocks, lines: int) -> None:
         nonlocal n_lines
@@ -237,7 +242,7 @@ def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: 
     except GcodeError as exc:  # strict mode: raised later unless a line run before it failed
         reading_error = exc
     if bar is not None:
-        bar.close()
+        bar.set_postfix_str(f"joining {n_lines:,} lines")
     sizes = [len(t) for t in tables]
     table = CommandTable.concat(tables) if tables else empty_table(parser, program)
     if not tables:

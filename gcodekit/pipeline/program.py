@@ -153,10 +153,18 @@ def quote_diagnostics(diagnostics: Diagnostics, program: Program, limit: int = 1
 
 
 def progress_bar(program: Program, enabled: bool):
+    """A bar on standard error counting the program's bytes as they are read (out of the file's size
+    when it is plain text; a compressed file's text size is not known before it is read); the
+    pipeline names the later steps (joining, planning) in it."""
     if not enabled:
         return None
     from tqdm import tqdm
 
-    total = program.path.stat().st_size if program.path is not None and program.path.suffix != ".gz" else None
+    total = None
+    if program.path is not None:
+        with open(program.path, "rb") as f:
+            head = f.read(6)
+        if not head.startswith((b"\x1f\x8b", b"BZh", b"\xfd7zXZ")):  # the containers read/source.py opens
+            total = program.path.stat().st_size
     return tqdm(total=total, unit="B", unit_scale=True, desc=Path(program.name).name, file=sys.stderr,
                 leave=False)
