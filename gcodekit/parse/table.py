@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..lathe_profile import LatheProfile
+from ..memory import release_freed_memory
 from ..syntax.flavor import COMMANDS, code_label
 from .commands import COMMAND_CLASSES, Command, Kind
 
@@ -203,6 +204,8 @@ class CommandTable:
                 params[letter] = np.concatenate([
                     np.full(size, np.nan) if c is None else (c.dense() if isinstance(c, SparseColumn) else c)
                     for c, size in zip(cols, sizes)])
+            del cols
+            release_freed_memory()  # the chunks' column, freed amid live ones: its pages back now
         named = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.named.items()}
         texts = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.texts.items()}
         profiles = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.profiles.items()}
@@ -239,4 +242,5 @@ def _cat(parts: list[CommandTable], attr: str) -> np.ndarray:
     out = np.concatenate([getattr(p, attr) for p in parts])
     for p in parts:
         setattr(p, attr, None)
+    release_freed_memory()
     return out

@@ -8,6 +8,7 @@ from ..emulate.machine import Machine
 from ..emulate.presets import MachineConfig
 from ..errors import Diagnostics, GcodeError
 from ..limits import PLAUSIBLE_TIME_S, Limits
+from ..memory import release_freed_memory
 from ..model.operation import Operation
 from ..parse import CommandTable, GcodeParser
 from ..read import Blocks
@@ -44,6 +45,8 @@ def concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarra
             out[key] = np.broadcast_to(first, (sum(c.size for c in cols),))
         else:
             out[key] = np.concatenate(cols)
+        del cols
+        release_freed_memory()  # the chunks' column, freed amid the live ones: give its pages back now
     return out
 
 
