@@ -24,7 +24,7 @@ from ..limits import MAX_MOTIONS, MotionBudget, TooManyMotions
 from ..parse.commands import Kind
 from ..parse.split import MOTIONS
 from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_RAPID, MOTION_THREAD, NAME_ID,
-                           SPLINE_MOTIONS, CommandTable)
+                           SPLINE_MOTIONS, CommandTable, in_ids)
 from ..schema import allocate
 from ..units import MM_PER_INCH, mm_per
 from . import arcs
@@ -173,15 +173,16 @@ class Machine:
         stop = 0 if self.out_of_budget else min(n, self.budget.room)  # each block makes a waypoint
         self.budget.spend(stop)
         out = allocate(n)
-        special = np.isin(table.name, self.modal.special_ids) | (table.letter == ord("T"))
+        special = in_ids(table.name, self.modal.special_ids) | (table.letter == ord("T"))
         special |= table.kind == Kind.MACHINE_COORDINATES
-        special |= np.isin(table.motion, (MOTION_CYCLE, MOTION_THREAD) + SPLINE_MOTIONS) & np.isin(table.kind, _MOVING)
+        moving_kind = in_ids(table.kind, _MOVING)
+        special |= in_ids(table.motion, (MOTION_CYCLE, MOTION_THREAD) + SPLINE_MOTIONS) & moving_kind
         if self.rs274_blocks:
             self._check_axis_words(table)
-        special |= mode_rows(table, "polar_on", "polar_off", self.state.polar) & np.isin(table.kind, _MOVING)
+        special |= mode_rows(table, "polar_on", "polar_off", self.state.polar) & moving_kind
         for letter in "@^":  # polar words depend on where the tool is: one block at a time
             if letter in table.params:
-                special |= ~np.isnan(table.param(letter)) & np.isin(table.kind, _MOVING)
+                special |= ~np.isnan(table.param(letter)) & moving_kind
         if self.config.block_delete and table.deleted.size:
             special[table.deleted] = True
         probing = (table.name == NAME_ID["probe"]) & ~special
@@ -213,7 +214,7 @@ class Machine:
             self._out_of_budget(int(table.line[stop]), f"the program makes more than max_motions="
                                 f"{self.budget.limit:,} motions")
         self.modal.context.cycle_mode.open = bool(n) and int(table.motion[-1]) == MOTION_CYCLE
-        setting = np.flatnonzero((table.letter == ord("G")) & np.isin(table.name, self._motion_mode_ids))
+        setting = np.flatnonzero((table.letter == ord("G")) & in_ids(table.name, self._motion_mode_ids))
         if setting.size:  # the motion mode in force (#<_motion_mode>)
             self.state.motion_code = int(table.number[setting[-1]])
         if cursor < n:
@@ -299,9 +300,9 @@ class Machine:
         rows = slice(start, stop)
         n = stop - start
         kind = t.kind[rows]
-        moving = np.isin(kind, _MOVING)
+        moving = in_ids(kind, _MOVING)
         if self.config.empty_moves:
-            moving |= np.isin(t.name[rows], self._straight_ids)
+            moving |= in_ids(t.name[rows], self._straight_ids)
         if not self.config.radius_arcs and "R" in t.params:
             self._reject_radius_arcs(t, rows, moving)
         motion = np.where(moving, t.motion[rows], 0).astype(np.uint8)
@@ -415,7 +416,7 @@ class Machine:
         if "S" not in t.params:
             return np.full(rows.stop - rows.start, self.state.speed)
         words = _dense(t.params["S"], rows).copy()
-        words[~np.isin(kind, _MILL)] = np.nan
+        words[~in_ids(kind, _MILL)] = np.nan
         return _forward_fill(words, self.state.speed)
 
     def _arcs(self, t, start, idx, start_pos, end_pos, centers, distance) -> None:

@@ -29,13 +29,15 @@ from .lathe_profiles import lathe_profiles
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
 from .word_checks import MODAL_USERS, WORD_USERS, stray_letters, stray_word_message, user_code_keys
 from .table import (CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CCW, MOTION_CUBIC, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, MOTION_NONE, MOTION_NURBS, MOTION_OF_NAME,
-                    MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable)
+                    MOTION_QUADRATIC, MOTION_THREAD, NAME_ID, CommandTable, in_ids)
 
 _G, _M, _T, _NAMED = ord("G"), ord("M"), ord("T"), ord("@")
 #: LinuxCNC's log comments: (LOGOPEN,file), (LOGAPPEND,file), (LOG,text), (LOGCLOSE)
 _LOG_COMMENT = re.compile(rb"(?i)\s*(?:log(?:open|append)?\s*,|logclose\s*$)")
 _LOG_HINT = re.compile(rb"(?i)log")
 _KEEP = 255  # "this row does not set the motion mode"
+_CODE_TENTHS = 100_000  # G and M numbers below 10000, in tenths: the names the parser keeps in a table
+_UNNAMED = 255  # a slot of that table not yet named
 #: Parameter letters and their row in the per-chunk parameter table.
 PARAM_LETTERS = "ABCDEFGHIJKLMNOPQRSTUVWXYZ@^"
 _LETTER_ROW = np.full(256, -1, np.int64)
@@ -70,6 +72,8 @@ class GcodeParser:
         self._modal = self.flavor.block_split == "modal"
         self._modal_motion = self.flavor.block_split != "single"  # firmware needs a code on every move
         self._name_cache: dict[int, int] = {}
+        # name ids by slot (see _name_ids): G numbers, M numbers, then the other letters
+        self._name_table = np.full(2 * _CODE_TENTHS + 256, _UNNAMED, np.uint8)
         self._unknown_reported: set[str] = set()
         self._extruder_letters = tuple(k for k, v in self.flavor.words.items() if v == "e" and k != "E")
         self._cycle_ids = np.array([NAME_ID[n] for n in CYCLE_NAMES], np.uint8)
@@ -124,7 +128,7 @@ class GcodeParser:
         block = rows["block"]
         first_row = np.full(len(blocks), -1, np.int64)
         first_row[block[::-1]] = np.arange(block.size)[::-1]
-        profiles, comments = lathe_profiles(blocks, block, np.flatnonzero(np.isin(rows["name"], self._lathe_ids)))
+        profiles, comments = lathe_profiles(blocks, block, np.flatnonzero(in_ids(rows["name"], self._lathe_ids)))
         comment_rows = first_row[comments.block]
         parts = rows["parts_by_row"]
         named = {i: p.named for i, p in parts.items() if p.named is not None}
@@ -152,13 +156,13 @@ class GcodeParser:
     def _axis_words_on_non_consumer(self, blocks, is_code, is_param, n_codes) -> np.ndarray:
         """Blocks like ``G90 X0``: one code that does not take the axis words."""
         wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
-        axis = is_param & np.isin(wl, np.array([ord(c) for c in AXIS_LETTERS], np.uint8))
+        axis = is_param & in_ids(wl, [ord(c) for c in AXIS_LETTERS])
         has_axis = np.bincount(wb[axis], minlength=len(blocks)) > 0
         code_rows = np.flatnonzero(is_code)
         consumer = np.zeros(len(blocks), bool)
         names = self._name_ids(wl[code_rows], wv[code_rows])
         consumer_ids = np.array([NAME_ID[n] for n in AXIS_CONSUMERS if n in NAME_ID])
-        consumer[wb[code_rows]] = np.isin(names, consumer_ids)
+        consumer[wb[code_rows]] = in_ids(names, consumer_ids)
         return has_axis & (n_codes == 1) & ~consumer
 
     @staticmethod
@@ -278,19 +282,34 @@ class GcodeParser:
     # -- classification -------------------------------------------------------
 
     def _name_ids(self, letters: np.ndarray, values_or_tenths: np.ndarray, tenths: bool = False) -> np.ndarray:
-        """Normalized-name ids for codes given by letter and number."""
+        """Normalized-name ids for codes given by letter and number.
+
+        Names already met are looked up in a table (G and M numbers in
+        tenths below :data:`_CODE_TENTHS`, other letters by the letter);
+        the rest are named by the flavor and added to it.
+        """
         numbers = values_or_tenths if tenths else np.round(values_or_tenths * 10)
-        numbers = np.where((letters == _G) | (letters == _M), numbers, 0)
-        keys = letters.astype(np.int64) * 1_000_000 + numbers.astype(np.int64)
-        uniq, inverse = np.unique(keys, return_inverse=True)
-        ids = np.empty(uniq.size, np.uint8)
-        for i, key in enumerate(uniq.tolist()):
-            if key not in self._name_cache:
-                letter, number = divmod(key, 1_000_000)
-                name = code_name(self.flavor, chr(letter), number / 10) if letter else ""
-                self._name_cache[key] = NAME_ID.get(name, 0)
-            ids[i] = self._name_cache[key]
-        return ids[inverse]
+        is_g, is_m = letters == _G, letters == _M
+        numbers = np.where(is_g | is_m, numbers, 0)
+        in_range = (numbers >= 0) & (numbers < _CODE_TENTHS)
+        slot = np.where(is_g, 0, np.where(is_m, _CODE_TENTHS, 2 * _CODE_TENTHS + letters.astype(np.int64)))
+        slot = np.where(in_range, slot + np.where(in_range, numbers, 0).astype(np.int64), -1)
+        ids = self._name_table[slot]
+        unknown = np.flatnonzero((ids == _UNNAMED) | (slot < 0))
+        if unknown.size:
+            keys = letters[unknown].astype(np.int64) * 1_000_000 + numbers[unknown].astype(np.int64)
+            uniq, inverse = np.unique(keys, return_inverse=True)
+            named = np.empty(uniq.size, np.uint8)
+            for i, key in enumerate(uniq.tolist()):
+                if key not in self._name_cache:
+                    letter, number = divmod(key, 1_000_000)
+                    name = code_name(self.flavor, chr(letter), number / 10) if letter else ""
+                    self._name_cache[key] = NAME_ID.get(name, 0)
+                named[i] = self._name_cache[key]
+            ids[unknown] = named[inverse]
+            known = slot[unknown] >= 0
+            self._name_table[slot[unknown][known]] = ids[unknown][known]
+        return ids
 
     def _classify(self, t: dict) -> None:
         """Fill name, motion and kind of every row."""
@@ -307,10 +326,10 @@ class GcodeParser:
         for mname, mode in _MOTION_MODES.items():
             sets[name == NAME_ID[mname]] = mode
         sets[(name == NAME_ID["cancel_cycle"]) | (name == NAME_ID["nurbs_end"])] = MOTION_NONE
-        sets[np.isin(name, self._cycle_ids)] = MOTION_CYCLE
+        sets[in_ids(name, self._cycle_ids)] = MOTION_CYCLE
         # After a lathe cycle (G70-G72) rs274 is in the mode of the cycle's last move,
         # which only the machine knows: axis words alone stay cycle rows for it to settle
-        lathe = np.isin(name, self._lathe_ids)
+        lathe = in_ids(name, self._lathe_ids)
         g53 = name == NAME_ID["machine_coordinates"]
         for i in np.flatnonzero(g53 & (letter != 0)):
             part = t.get("parts_by_row", {}).get(int(i))
@@ -336,7 +355,7 @@ class GcodeParser:
         has_axes, has_e, has_s, has_f = has("XYZABCUVW@^"), has("E"), has("S"), has("F")
         arc = (motion == 3) | (motion == 4)
         has_axes |= arc & has("IJKR")  # "G2 I5" is a full circle from where the tool is
-        is_motion_name = np.isin(name, [NAME_ID[m] for m in _MOTION_MODES]) | np.isin(name, self._cycle_ids)
+        is_motion_name = in_ids(name, [NAME_ID[m] for m in _MOTION_MODES] + self._cycle_ids.tolist())
         implicit = (letter == 0) & has_axes if self._modal_motion else np.zeros(n, bool)
         probing = implicit & (probe >= 0) & (motion == MOTION_LINEAR)
         name[probing] = NAME_ID["probe"]
@@ -375,7 +394,7 @@ class GcodeParser:
             self.diagnostics.warn(int(t["line"][i]), 1, "words without a command are ignored by this firmware")
         kind[orphan] = Kind.CONFIG
         if self.flavor.required_axes:
-            straight = np.isin(name, [NAME_ID["rapid"], NAME_ID["linear"]])
+            straight = in_ids(name, [NAME_ID["rapid"], NAME_ID["linear"]])
             missing = np.zeros(n, bool)
             for letter in self.flavor.required_axes:
                 missing |= ~has(letter)

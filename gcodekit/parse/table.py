@@ -40,6 +40,13 @@ CYCLE_NAMES = ("cycle_chip_break", "cycle_drill", "cycle_drill_dwell", "cycle_pe
 _SPARSE_BELOW = 0.02  # a parameter present in fewer rows than this is kept sparse
 
 
+def in_ids(values: np.ndarray, ids) -> np.ndarray:
+    """``np.isin(values, ids)`` for small codes (0..255, the uint8 columns): one table lookup per row."""
+    lut = np.zeros(256, bool)
+    lut[np.asarray(ids, np.int64)] = True
+    return lut[values]
+
+
 @dataclass
 class SparseColumn:
     """A mostly-NaN column stored as sorted row indices and values."""

@@ -100,7 +100,8 @@ def program_blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, b
                 bar.update(len(c))
             yield c
 
-    for blocks in iter_blocks(counted(), flavor, diagnostics):  # each holds every chunk taken so far
+    size = program.path.stat().st_size if program.path is not None and not program.preprocessed else 0
+    for blocks in iter_blocks(counted(), flavor, diagnostics, size_hint=size):  # each holds every chunk taken so far
         yield blocks, lines_read[0] - lines_read[1]
         lines_read[1] = lines_read[0]
 

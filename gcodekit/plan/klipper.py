@@ -364,9 +364,13 @@ def _cruise(start_v2, mcr_start_v2, m, flush):
 
 
 def _set_junction(start_v2, cruise_v2, next_start_v2, m) -> PlanResult:
-    """Move.set_junction: the trapezoid of each move (in blocks: fewer temporaries at once)."""
+    """Move.set_junction: the trapezoid of each move (in blocks: fewer temporaries at once).
+
+    The speeds are written over ``start_v2``, ``cruise_v2`` and
+    ``next_start_v2`` (a block after it is read), which the caller drops.
+    """
     n = start_v2.size
-    result = PlanResult(np.empty(n), np.empty(n), np.empty(n), m["accel"], np.empty(n), np.empty(n), np.empty(n))
+    result = PlanResult(start_v2, cruise_v2, next_start_v2, m["accel"], np.empty(n), np.empty(n), np.empty(n))
     for lo in range(0, n, BLOCK):
         sl = slice(lo, min(lo + BLOCK, n))
         _set_junction_block(start_v2[sl], cruise_v2[sl], next_start_v2[sl], m["accel"][sl], m["move_d"][sl],

@@ -310,7 +310,8 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     entry_speed_sqr, exit_speed_sqr = lookahead(block["max_entry_speed_sqr"], delta_v2, rest_after,
                                                 rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
     del block, delta_v2, nominal_length, rest_after
-    return planned, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr)
+    return planned, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr,
+                              reuse=True)
 
 
 def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, config: MarlinConfig,

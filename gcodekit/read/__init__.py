@@ -49,6 +49,7 @@ def iter_blocks(
     diagnostics: Diagnostics,
     *,
     engine: str = "auto",
+    size_hint: int = 0,
 ) -> Iterator[Blocks]:
     """Read chunks of whole lines into :class:`Blocks`, one per chunk.
 
@@ -58,7 +59,9 @@ def iter_blocks(
     compiled loop of :mod:`.scan_kernel`; Numba must be installed) or
     ``"auto"``: NumPy, and the compiled loop from
     :data:`COMPILED_AFTER_BYTES` on when Numba is installed.  Both give the
-    same blocks.  Chunks read by the compiled loop are joined to about
+    same blocks.  ``size_hint`` (the file's size on disk, when known)
+    lets "auto" start with the compiled loop when it is that large already.
+    Chunks read by the compiled loop are joined to about
     :data:`COMPILED_CHUNK_BYTES`: a yielded chunk holds every chunk taken
     from ``chunks`` so far, none read ahead.
     """
@@ -68,7 +71,7 @@ def iter_blocks(
     tokenizer = LineTokenizer(flavor, diagnostics)
     first_line = 0
     fast = fast_path_possible(flavor)
-    read = 0
+    read = size_hint if size_hint >= COMPILED_AFTER_BYTES else 0
     pending: list[bytes] = []
     waiting = 0
     for data in chunks:
@@ -81,17 +84,19 @@ def iter_blocks(
             if waiting < COMPILED_CHUNK_BYTES:
                 continue
             data, pending, waiting = b"".join(pending), [], 0
-        yield _read(data, first_line, flavor, tokenizer, diagnostics, fast, compiled)
-        first_line += data.count(b"\n")
+        part, lines = _read(data, first_line, flavor, tokenizer, diagnostics, fast, compiled)
+        first_line += lines
+        yield part
     if pending:
-        yield _read(b"".join(pending), first_line, flavor, tokenizer, diagnostics, fast, True)
+        yield _read(b"".join(pending), first_line, flavor, tokenizer, diagnostics, fast, True)[0]
 
 
 def _read(data: bytes, first_line: int, flavor: Flavor, tokenizer: LineTokenizer, diagnostics: Diagnostics,
-          fast: bool, compiled: bool) -> Blocks:
+          fast: bool, compiled: bool) -> tuple[Blocks, int]:
+    """The blocks of a chunk and its number of lines."""
     if fast:
         return _read_fast(data, first_line, flavor, tokenizer, diagnostics, compiled)
-    return _read_slow(data, first_line, tokenizer, diagnostics)
+    return _read_slow(data, first_line, tokenizer, diagnostics), data.count(b"\n")
 
 
 def _line_text(data: bytes, start: int, end: int) -> str:
@@ -116,7 +121,7 @@ def _tokenize(tokenizer: LineTokenizer, line: bytes, number: int, diagnostics: D
 def _read_fast(
     data: bytes, first_line: int, flavor: Flavor, tokenizer: LineTokenizer, diagnostics: Diagnostics,
     compiled: bool = False,
-) -> Blocks:
+) -> tuple[Blocks, int]:
     s = (scan_kernel.scan_compiled if compiled else scan)(data, flavor, MAX_LINE_LENGTH)
     n = s.n_lines
     ends = np.r_[s.line_start[1:] - 1, len(data) - 1]
@@ -133,10 +138,10 @@ def _read_fast(
         s.word_col, s.comment_line, s.comment_col, s.comment_offsets, s.comment_data,
     )
     if not raw_blocks:
-        return fast
+        return fast, n
     slow = Blocks.from_raw(diagnostics.file, raw_blocks)
     lines = np.array(raw_lines, np.int32)
-    return _merge(fast, slow, lines)
+    return _merge(fast, slow, lines), n
 
 
 def _merge(fast: Blocks, slow: Blocks, slow_lines: np.ndarray) -> Blocks:
