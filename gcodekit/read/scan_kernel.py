@@ -90,18 +90,9 @@ def _scan_lines(b, classes, case_sensitive, spaces_in_numbers, max_line_length, 
     nw = nc = nd = ni = 0
     start = 0
     for line in range(n_newlines):
-        end = start
-        while b[end] != 10:
-            end += 1
         line_start[line] = start
         first_word = nw
-        ok = max_line_length < 0 or end - start <= max_line_length
-        # the line comment runs from the first comment character to the end of the line
-        code_end = end
-        for i in range(start, end):
-            if classes[b[i]] == _COMMENT:
-                code_end = i
-                break
+        ok = True
         prev_letter = False
         prev_num = False
         in_word = False
@@ -112,15 +103,16 @@ def _scan_lines(b, classes, case_sensitive, spaces_in_numbers, max_line_length, 
         contiguous = True
         letter = 0
         col = 0
+        code_end = -1  # where the code ends: the line comment's first character, or the newline
         i = start
-        while ok and i <= code_end:
-            if i == code_end:
-                c = _NEWLINE  # the comment (or the line) ends the code
-            else:
-                c = classes[b[i]]
-                if c == _BLANK:
-                    i += 1
-                    continue
+        while True:
+            c = classes[b[i]]
+            if c == _BLANK:
+                i += 1
+                continue
+            if c == _COMMENT or c == _NEWLINE:
+                code_end = i
+                c = _NEWLINE  # the line comment runs from its first character to the end of the line
             is_letter = c == _UPPER or (c == _LOWER and not case_sensitive)
             is_num = c == _DIGIT or c == _DOT or c == _SIGN
             if is_letter or c == _NEWLINE:
@@ -195,8 +187,13 @@ def _scan_lines(b, classes, case_sensitive, spaces_in_numbers, max_line_length, 
                 ok = False  # another byte, or a lower-case letter where that is no word
                 break
             i += 1
+        end = i
+        while b[end] != 10:
+            end += 1
         if ok and in_word:
             ok = False  # a letter without a number at the end of the line
+        if max_line_length >= 0 and end - start > max_line_length:
+            ok = False
         if not ok:
             nw = first_word
             irregular[ni] = line
