@@ -145,7 +145,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
             if config.planner == "marlin" and machine_config is None:
                 settings = _with_slicer_limits(op, settings, chosen=machine is not None)
             if bar is not None:
-                bar.set_postfix_str(f"planning {len(op.waypoints['x']):,} moves ({config.planner})")
+                bar.set_postfix_str(f"planning ({config.planner})")
             op.attach_plan(run_planner(op, config.planner, settings))
     finally:
         if bar is not None:
