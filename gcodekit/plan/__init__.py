@@ -92,12 +92,19 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
     planner's crawl at its minimum speed.
     """
     n = w["x"].size
-    planned = np.bincount(moves.waypoint, weights=result.duration_t, minlength=n)
-    has_moves = np.bincount(moves.waypoint, minlength=n) > 0
-    times = np.where(has_moves, planned, np.where(w["motion"] > 0, 0.0, w["time"]))
+    duration_t = result.accel_t + result.cruise_t  # duration_t, summed in place: one array fewer at the peak
+    duration_t += result.decel_t
+    # (np.bincount of no moves gives integers, whatever the weights)
+    times = np.bincount(moves.waypoint, weights=duration_t, minlength=n).astype(np.float64, copy=False)
+    del duration_t
+    has_moves = np.zeros(n, bool)
+    has_moves[moves.waypoint] = True
+    idle = np.flatnonzero(~has_moves)
+    times[idle] = np.where(np.asarray(w["motion"])[idle] > 0, 0.0, np.asarray(w["time"])[idle])
     # a feed move with no feed in force has no time a planner could know (its minimum speed is no answer)
     unknown = (np.asarray(w["motion"]) >= 2) & ~(np.asarray(w["feed"], float) > 0) & (np.asarray(w["distance"]) > 0)
-    return np.where(unknown, np.nan, times)
+    times[unknown] = np.nan
+    return times
 
 
 def waypoint_speeds(plan: tuple[PlannedMoves, PlanResult], n: int) -> dict[str, np.ndarray]:

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import ConfigError
+from ..memory import release_freed_memory
 from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
 
@@ -220,6 +221,7 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
         _move_block(moves, rows, limits, config, flush, lo, hi, m, junction)
     planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, m["move_d"])
     del moves  # the end points are no longer needed: free them before the passes
+    release_freed_memory()
 
     # max_start_v2 = min(cap, prev.max_start_v2 + prev.delta_v2): forward scans
     max_start_v2 = forward_min(m.pop("cap"), m["delta_v2"])
@@ -230,6 +232,7 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
     del max_start_v2, max_mcr_start_v2
     cruise_v2, next_start_v2 = _cruise(start_v2, mcr_start_v2, m, flush)
     del mcr_start_v2, m["max_cruise_v2"], m["delta_v2"], m["mcr_delta_v2"]  # free before the trapezoids
+    release_freed_memory()
     return planned, _set_junction(start_v2, cruise_v2, next_start_v2, m)
 
 

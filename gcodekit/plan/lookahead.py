@@ -77,11 +77,17 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     if nominal_length is not None:
         bound = np.where(nominal_length, max_entry_v2, bound)
     reverse_v2 = backward_min(bound, np.where(free, bound, delta_v2))
+    del bound  # each array dropped as soon as it is used: the plan of a large program is memory-bound
     forward_inc = delta_v2.copy()
     cut = np.flatnonzero(free[:-1])
+    del free
     forward_inc[cut] = reverse_v2[cut + 1]
     entry_v2 = forward_min(reverse_v2, forward_inc, first=float(reverse_v2[0])) if n else reverse_v2
-    exit_v2 = np.where(rest_after, rest_v2, np.r_[entry_v2[1:], rest_v2])
+    del forward_inc, reverse_v2
+    exit_v2 = np.empty(n)
+    exit_v2[:-1] = entry_v2[1:]
+    exit_v2[-1:] = rest_v2
+    exit_v2[rest_after] = rest_v2
     return entry_v2, exit_v2
 
 

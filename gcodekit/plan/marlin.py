@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Mapping
 import numpy as np
 
 from ..errors import ConfigError
+from ..memory import release_freed_memory
 from .lookahead import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
 from .moves import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before,
                     m204_in_force, settings_in_force, speed_factor)
@@ -300,6 +301,7 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     millimeters, acceleration, nominal_speed = block["millimeters"], block["acceleration"], block["nominal_speed"]
     planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, millimeters)
     del moves  # the end points are no longer needed: free them before the passes
+    release_freed_memory()
     minimum_planner_speed_sqr = config.minimum_planner_speed**2
     delta_v2 = 2.0 * acceleration * millimeters
     nominal_speed_sqr = nominal_speed * nominal_speed
@@ -310,6 +312,7 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     entry_speed_sqr, exit_speed_sqr = lookahead(block["max_entry_speed_sqr"], delta_v2, rest_after,
                                                 rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
     del block, delta_v2, nominal_length, rest_after
+    release_freed_memory()  # the passes' temporaries, before the trapezoids' arrays
     return planned, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr,
                               reuse=True)
 
