@@ -78,8 +78,10 @@ def check_program(program: str | None, requirements: Sequence[Requirement], mach
 
     if program is None or not str(program).strip():
         return ProgramCheck(None, "Not answered yet: write your program in the cell above and run both cells again.")
+    # a program written as """ + newline + lines: its first G-code line is line 1, as the student counts
+    program = str(program)[1:] if str(program).startswith("\n") else str(program)
     try:
-        op = gcode_to_operation(str(program), machine, **options)
+        op = gcode_to_operation(program, machine, **options)
     except Exception as exc:  # a program gcodekit refuses: say why, with its line
         return ProgramCheck(False, f"Not yet: gcodekit cannot run your program: {exc}")
     errors = [str(d).replace("<string>:", "line ", 1) for d in op.diagnostics.errors]
@@ -88,7 +90,7 @@ def check_program(program: str | None, requirements: Sequence[Requirement], mach
                             + "\n- ".join(errors[:3]), op, ["runs without errors"])
     failed = []
     for requirement in requirements:
-        problem = requirement.test(op, str(program))
+        problem = requirement.test(op, program)
         if problem:
             failed.append(f"{requirement.text}: {problem}")
     if not failed:
