@@ -107,7 +107,8 @@ WRONG = {
     "06-cutter-compensation-and-stages": {1: 90, 3: "conventional"},
     "07-planned-against-naive-time": {
         1: 1.0, 2: 437.24 / 2500, 3: 100.0,
-        5: 4.6, 6: 5.0,  # the new time instead of the saving; the square corner's speed at every corner
+        5: 4.6,  # the new time instead of the saving
+        6: _corner_speed(3000, 5**2 * (math.sqrt(2) - 1) / 3000, 45),  # the turn's 45 degrees taken for theta
         7: 0.04 * _E_PER_MM * 100,  # slowed down to a stop
     },
     "08-extrusion-retraction-temperatures": {
@@ -158,6 +159,8 @@ WRONG_PROGRAMS = {
         (lambda: _edit("04-canned-cycles", 2, "G98 X30", "X30"), "the tool passes over it at Z1"),
         (lambda: _edit("04-canned-cycles", 2, "Z-5 R1", "Z-4 R1"), "goes down to Z-4"),
         (lambda: _edit("04-canned-cycles", 2, "X10\nG80", "G80"), "no hole at X10 Y30"),
+        # G98 left in force after the clamp: up to Z15 after the third hole too (13.18 s against 13.74 s)
+        (lambda: _edit("04-canned-cycles", 2, "G99 X30 Y30", "X30 Y30"), "it takes 13.74 s"),
     ],
     ("05-feeds-and-speeds", 2): [
         (lambda: _edit("05-feeds-and-speeds", 2, "S7960", "S796"), "rpm: too slow for this cutter"),
@@ -166,11 +169,13 @@ WRONG_PROGRAMS = {
     ],
     ("06-cutter-compensation-and-stages", 2): [
         (lambda: _edit("06-cutter-compensation-and-stages", 2, "G41 D1", "G42 D1"),
-         "the tool centre leaves the box on line 9"),  # the entry move: G42 keeps the tool outside the wall
-        (lambda: _edit("06-cutter-compensation-and-stages", 2, "G40 G1 X20 Y10", "G40 G1 X-10 Y-10"),
-         "the tool centre leaves the box on line 15"),  # the exit move runs out through the wall
-        (lambda: _edit("06-cutter-compensation-and-stages", 2, "G0 X20 Y10 Z5", "G0 X-10 Y-10 Z5"),
-         "the tool centre leaves the box on line 8"),  # the plunge outside
+         "the tool centre leaves the box on line 8"),  # the entry move: G42 keeps the tool outside the wall
+        (lambda: _edit("06-cutter-compensation-and-stages", 2, "G40 G1 X30 Y10", "G40 G1 X-10 Y-10"),
+         "the tool centre leaves the box on line 14"),  # the exit move runs out through the wall
+        (lambda: _edit("06-cutter-compensation-and-stages", 2, "G0 X30 Y10 Z5", "G0 X-10 Y-10 Z5"),
+         "the tool centre leaves the box on line 7"),  # the plunge outside
+        # the program printed above the exercise, which plunges at X20 Y10
+        (lambda: (WORKSHEETS / "programs" / "pocket_wall.ngc").read_text(), "the tool goes down to Z-1 at X30 Y10"),
     ],
     ("07-planned-against-naive-time", 4): [
         (lambda: _program("07-planned-against-naive-time", 4).replace("F9000", "F6000"), "it takes"),
