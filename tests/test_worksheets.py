@@ -466,7 +466,7 @@ STUDENTS = ("right", "empty", "wrong")
 def _graded_course(root: Path, NbGraderAPI, Config):
     """The course of the fixture above, graded: (root, scores)."""
     source = root / "source" / "worksheets"
-    shutil.copytree(WORKSHEETS, source, ignore=shutil.ignore_patterns("README.md", "nbgrader_config.py", "*.html"))
+    shutil.copytree(WORKSHEETS, source, ignore=shutil.ignore_patterns("*.md", "nbgrader_config.py", "*.html"))
     shutil.copy(WORKSHEETS / "nbgrader_config.py", root / "nbgrader_config.py")
     config = Config()
     exec((WORKSHEETS / "nbgrader_config.py").read_text(), {"get_config": lambda: config})

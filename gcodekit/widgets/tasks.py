@@ -195,7 +195,7 @@ def passes_through(points: Sequence[Sequence[float]], *, cutting: bool = True, t
         if not missed:
             return None
         if says is not None:
-            return f"it misses {len(missed)} of the {len(points)} places"
+            return "it never gets there" if len(points) == 1 else f"it misses {len(missed)} of the {len(points)} places"
         return ("the cut never reaches " if cutting else "the tool never reaches ") + ", ".join(_xyz(p) for p in missed)
 
     text = ("cuts through " if cutting else "goes through ") + ", ".join(_xyz(p) for p in points)
@@ -519,10 +519,26 @@ def heater_waits(op: "Operation", rates: Mapping[str, float], room: float = 25.0
     the heater has reached its target from below, as Marlin's ``M109 S`` does; a target below the heater's
     temperature is not waited for.
 
+    Parameters
+    ----------
+    op : Operation
+    rates : mapping of str to float
+        °C/s per heater (``{"nozzle": 2.5, "bed": 0.5}``); a heater left out is not modelled.
+    room : float, default: 25.0
+        Every heater's temperature at the start, °C.
+
     Returns
     -------
     list of (line, heater, seconds)
         One entry per wait, in program order.
+
+    Examples
+    --------
+    Waiting for the bed before the nozzle's target is even set: 35 °C at 0.5 °C/s, then 185 °C at 2.5 °C/s.
+
+    >>> from gcodekit.pipeline import gcode_to_operation
+    >>> heater_waits(gcode_to_operation("M190 S60\nM109 S210\nG1 X10 F600\n", "marlin"), {"nozzle": 2.5, "bed": 0.5})
+    [(1, 'bed', 70.0), (2, 'nozzle', 74.0)]
     """
     w = op.waypoints
     command = np.asarray(w["command"])
@@ -574,7 +590,8 @@ def waits_for_heaters(bed: float, nozzle: float) -> Requirement:
         line = int(op.commands[first].line)
         problems = []
         if waits["wait_bed_temp"] is None:
-            problems.append(f"nothing waits for the bed to reach {bed:g} °C before the first printed line (line {line})")
+            problems.append(f"nothing waits for the bed to reach {bed:g} °C before the first printed line "
+                            f"(line {line})")
         if waits["wait_hotend_temp"] is None:
             problems.append(f"nothing waits for the nozzle to reach {nozzle:g} °C before the first printed line "
                             f"(line {line})")
