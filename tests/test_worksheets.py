@@ -22,7 +22,6 @@ import io
 import math
 import os
 import re
-import shlex
 import shutil
 from pathlib import Path
 
@@ -463,17 +462,35 @@ def course(tmp_path_factory):
 STUDENTS = ("right", "empty", "wrong")
 
 
-def _graded_course(root: Path, NbGraderAPI, Config):
-    """The course of the fixture above, graded: (root, scores)."""
-    source = root / "source" / "worksheets"
-    shutil.copytree(WORKSHEETS, source, ignore=shutil.ignore_patterns("*.md", "nbgrader_config.py", "*.html"))
-    shutil.copy(WORKSHEETS / "nbgrader_config.py", root / "nbgrader_config.py")
+def _config(root: Path, Config):
+    """nbgrader's configuration for the course in ``root``: the worksheets' nbgrader_config.py and the course."""
     config = Config()
     exec((WORKSHEETS / "nbgrader_config.py").read_text(), {"get_config": lambda: config})
     config.CourseDirectory.root = str(root)
     config.CourseDirectory.db_url = f"sqlite:///{root / 'gradebook.db'}"
     config.ExecutePreprocessor.timeout = 600
-    api = NbGraderAPI(config=config)
+    return config
+
+
+def _grade(root: Path, student: str, NbGraderAPI, Config) -> None:
+    """In a forked process: nbgrader's autograde and feedback for one student of the course in ``root``."""
+    import sys
+
+    api = NbGraderAPI(config=_config(root, Config))
+    os.chdir(root)
+    for step in (api.autograde, api.generate_feedback):
+        result = step("worksheets", student)
+        if not result["success"]:
+            (root / "grading.log").write_text(result["log"])
+            sys.exit(1)
+
+
+def _graded_course(root: Path, NbGraderAPI, Config):
+    """The course of the fixture above, graded: (root, scores)."""
+    source = root / "source" / "worksheets"
+    shutil.copytree(WORKSHEETS, source, ignore=shutil.ignore_patterns("*.md", "nbgrader_config.py", "*.html"))
+    shutil.copy(WORKSHEETS / "nbgrader_config.py", root / "nbgrader_config.py")
+    api = NbGraderAPI(config=_config(root, Config))
     with _in(root):
         generated = api.generate_assignment("worksheets")
     assert generated["success"], generated["log"]
@@ -483,39 +500,33 @@ def _graded_course(root: Path, NbGraderAPI, Config):
         shutil.copytree(released, folder)
         (folder / "timestamp.txt").write_text("2026-12-03 12:00:00.000000 UTC")
     for name in NAMES:
-        for cell_source in (WORKSHEETS / f"{name}.ipynb",):
-            src = nbformat.read(cell_source, as_version=4)
-            for student, answer in (("right", _teacher), ("wrong", _wrong)):
-                path = root / "submitted" / student / "worksheets" / f"{name}.ipynb"
-                nb = nbformat.read(path, as_version=4)
-                for cell, original in zip(nb.cells, src.cells):
-                    tags = original.metadata.get("tags", [])
-                    if any(t.startswith("answer-") for t in tags):
-                        cell.source = answer(name, int(tags[0].split("-")[1]), original.source)
-                nbformat.write(nb, path)
-    # nbgrader's own command line grades each student in a copy of the course (its own gradebook), the three at
-    # once: each autograde runs nine kernels one after the other, so three students side by side take about the
-    # time of one
-    import subprocess
-    import sys
+        src = nbformat.read(WORKSHEETS / f"{name}.ipynb", as_version=4)
+        for student, answer in (("right", _teacher), ("wrong", _wrong)):
+            path = root / "submitted" / student / "worksheets" / f"{name}.ipynb"
+            nb = nbformat.read(path, as_version=4)
+            for cell, original in zip(nb.cells, src.cells):
+                tags = original.metadata.get("tags", [])
+                if any(t.startswith("answer-") for t in tags):
+                    cell.source = answer(name, int(tags[0].split("-")[1]), original.source)
+            nbformat.write(nb, path)
+    # each student graded in a copy of the course (its own gradebook), the three side by side in processes forked
+    # from this one, which has nbgrader loaded already: each autograde runs nine kernels one after the other
+    import multiprocessing
 
-    nbgrader = shlex.quote(str(Path(sys.executable).parent / "nbgrader"))
+    from nbgrader.api import Gradebook
+
+    fork = multiprocessing.get_context("fork")
     running = {}
     for student in STUDENTS:
         copy = root.parent / f"{root.name}-{student}"
         shutil.copytree(root, copy, ignore=shutil.ignore_patterns(*[s for s in STUDENTS if s != student]))
-        log = (root.parent / f"{student}.log").open("w")
-        command = (f"{nbgrader} autograde worksheets --student {student} --ExecutePreprocessor.timeout=600 && "
-                   f"{nbgrader} generate_feedback worksheets --student {student}")
-        running[student] = (copy, log, subprocess.Popen(["bash", "-c", command], cwd=copy, stdout=log,
-                                                        stderr=subprocess.STDOUT))
-    from nbgrader.api import Gradebook
-
+        running[student] = copy, fork.Process(target=_grade, args=(copy, student, NbGraderAPI, Config))
+        running[student][1].start()
     scores = {}
-    for student, (copy, log, process) in running.items():
-        process.wait()
-        log.close()
-        assert process.returncode == 0, (root.parent / f"{student}.log").read_text()[-3000:]
+    for student, (copy, process) in running.items():
+        process.join()
+        log = copy / "grading.log"
+        assert process.exitcode == 0, log.read_text()[-3000:] if log.exists() else "see the captured stderr"
         for folder in ("autograded", "feedback"):
             shutil.copytree(copy / folder / student, root / folder / student)
         with Gradebook(f"sqlite:///{copy / 'gradebook.db'}") as gradebook:
