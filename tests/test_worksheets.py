@@ -273,6 +273,8 @@ def _forms(value) -> list[str]:
 
 
 def _holds(message: str, value) -> bool:
+    """Whether ``message`` says ``value`` (the count in "1 of 4 requirements not met" is no answer)."""
+    message = re.sub(r"\d+ of \d+ requirements", "", message)
     return any(re.search(rf"(?<![\d.]){re.escape(form)}(?![\d])", message) for form in _forms(value))
 
 
