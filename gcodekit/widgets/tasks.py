@@ -537,7 +537,7 @@ def heater_waits(op: "Operation", rates: Mapping[str, float], room: float = 25.0
     Waiting for the bed before the nozzle's target is even set: 35 °C at 0.5 °C/s, then 185 °C at 2.5 °C/s.
 
     >>> from gcodekit.pipeline import gcode_to_operation
-    >>> heater_waits(gcode_to_operation("M190 S60\nM109 S210\nG1 X10 F600\n", "marlin"), {"nozzle": 2.5, "bed": 0.5})
+    >>> heater_waits(gcode_to_operation("M190 S60\\nM109 S210\\nG1 X10 F600\\n", "marlin"), {"nozzle": 2.5, "bed": 0.5})
     [(1, 'bed', 70.0), (2, 'nozzle', 74.0)]
     """
     w = op.waypoints
