@@ -5,10 +5,10 @@ all and returns them as ``data:`` URIs so a page embeds them and works
 offline.  The toolpath pictures draw the one :class:`~gcodekit.view.Toolpath`
 with the one :class:`~gcodekit.view.Coloring` through
 :func:`gcodekit.visualize.draw_toolpath`, as the notebook viewer and the
-PyVista pictures do.  Large programs are thinned before drawing (every k-th
-layer in 3D, every k-th segment elsewhere, binned speeds) so a 150 k-line
-print draws in about a second: a picture 800 pixels wide cannot show more
-anyway.
+PyVista pictures do, every segment of the program but only those the
+picture's pixels show (:mod:`gcodekit.view.lod`), joined into polylines: a
+3 M-line print draws in seconds and looks as its full drawing does.  The
+speed plot bins the program's speeds.
 """
 
 from __future__ import annotations
@@ -27,9 +27,6 @@ if TYPE_CHECKING:
 
     from ..model.operation import Operation
 
-#: Segments drawn in the 3D view and the top view (beyond this they only add ink).
-MAX_3D_SEGMENTS = 25_000
-MAX_2D_SEGMENTS = 60_000
 THUMBNAILS = 12
 #: The pictures of a report page.
 FIGURES = ("iso", "top", "layer_times", "thumbnails", "velocity", "breakdown", "part")
@@ -79,26 +76,6 @@ def toolpath_drawing(op: "Operation", color_by: str | None = None) -> Drawing | 
     return Drawing(path, color, np.flatnonzero(keep))
 
 
-def _thin(drawing: Drawing, limit: int, by_layer: bool) -> Drawing:
-    """At most about ``limit`` segments: every k-th layer when layered, else every k-th segment."""
-    n = drawing.segments.size
-    if n <= limit:
-        return drawing
-    layer = drawing.layer
-    if by_layer and (layer >= 0).any():
-        ids = np.unique(layer[layer >= 0])
-        step = int(np.ceil(n / limit))
-        chosen = ids[::step]
-        if chosen[-1] != ids[-1]:
-            chosen = np.r_[chosen, ids[-1]]  # keep the top layer: it is what the part looks like
-        kept = drawing.take(np.isin(layer, chosen))
-        if kept.segments.size <= 2 * limit:
-            return kept
-        drawing = kept
-        n = drawing.segments.size
-    return drawing.take(np.arange(0, n, int(np.ceil(n / limit))))
-
-
 def _figure(height: float, **margins: float) -> "Figure":
     """A figure of the report's width with fixed margins (fractions of the figure).
 
@@ -116,13 +93,12 @@ def toolpath_iso(drawing: Drawing) -> "Figure":
     """The toolpath seen by the ``iso`` camera (orthographic, from +X, -Y, +Z), as the viewer shows it."""
     from ..visualize import add_legend, draw_toolpath, fitted_camera
 
-    drawing = _thin(drawing, MAX_3D_SEGMENTS, by_layer=True)
     fig = _figure(5.0)
     ax = fig.add_axes((0.0, 0.0, 0.78, 1.0))
     ax.set_axis_off()
     camera = fitted_camera("iso", drawing.path, 0.78 * WIDTH_IN / 5.0)
     vmin, vmax = draw_toolpath(ax, drawing.path, drawing.color, camera, drawing.segments,
-                               work_width=0.6, travel_width=0.5)
+                               work_width=0.6, travel_width=0.5, lod=True)
     add_legend(fig, drawing.color, drawing.path, drawing.segments, vmin, vmax)
     return fig
 
@@ -131,12 +107,11 @@ def toolpath_top(drawing: Drawing) -> "Figure":
     """Top view (XY) of the whole toolpath, axes in machine millimetres."""
     from ..visualize import add_legend, draw_toolpath, fitted_camera
 
-    drawing = _thin(drawing, MAX_2D_SEGMENTS, by_layer=False)
     fig = _figure(4.6)
     ax = fig.add_axes((0.09, 0.1, 0.69, 0.83))
     camera = fitted_camera("top", drawing.path, 0.69 * WIDTH_IN / (0.83 * 4.6))
     vmin, vmax = draw_toolpath(ax, drawing.path, drawing.color, camera, drawing.segments,
-                               work_width=0.5, travel_width=0.5, absolute=True)
+                               work_width=0.5, travel_width=0.5, absolute=True, lod=True)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("X, mm")
     ax.set_ylabel("Y, mm")
