@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..view import WORK, Coloring, Toolpath, ToolpathError, coloring, default_coloring
+from ..view import TRAVEL_COLOR, WORK, Coloring, Toolpath, ToolpathError, coloring, default_coloring
+from ..view.coloring import hex_rgb
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -51,17 +52,6 @@ class Drawing:
         if self.path.group_by != "layer":
             return np.full(self.segments.size, -1)
         return self.path.segment_group[self.segments]
-
-    @property
-    def start(self) -> np.ndarray:
-        return self.path.start[self.segments]
-
-    @property
-    def end(self) -> np.ndarray:
-        return self.path.end[self.segments]
-
-    def take(self, keep: np.ndarray) -> "Drawing":
-        return Drawing(self.path, self.color, self.segments[keep])
 
 
 def toolpath_drawing(op: "Operation", color_by: str | None = None) -> Drawing | None:
@@ -124,6 +114,8 @@ def layer_thumbnails(drawing: Drawing, count: int = THUMBNAILS) -> "Figure | Non
     """Small XY views of ``count`` layers spread over the height, on the part's extents."""
     from matplotlib.collections import LineCollection
 
+    from ..view.lod import polylines
+
     layer = drawing.layer
     ids = np.unique(layer[layer >= 0])
     if ids.size == 0:
@@ -132,17 +124,21 @@ def layer_thumbnails(drawing: Drawing, count: int = THUMBNAILS) -> "Figure | Non
     cols = 6
     rows = int(np.ceil(chosen.size / cols))
     fig = _figure(1.45 * rows + 0.2, left=0.01, right=0.99, bottom=0.02, top=0.92, wspace=0.08, hspace=0.25)
-    colours, _, _ = drawing.color.segment_rgb(drawing.path, drawing.segments)
-    start, end = drawing.start, drawing.end
     layered = layer >= 0  # the extents of the layers, not of a purge line drawn before them
-    lo, hi = start[layered, :2].min(axis=0), start[layered, :2].max(axis=0)
+    lo = drawing.path.start[drawing.segments[layered], :2].min(axis=0)
+    hi = drawing.path.start[drawing.segments[layered], :2].max(axis=0)
     pad = 0.03 * max(float((hi - lo).max()), 1.0)
     lo, hi = lo - pad, hi + pad
+    # colours of the chosen layers only, on the colour scale of the whole drawing
+    shown = np.flatnonzero(np.isin(layer, chosen))
+    colours = _colours(drawing, shown)
+    picked = drawing.segments[shown]
+    start, end, layer = drawing.path.start[picked, :2], drawing.path.end[picked, :2], layer[shown]
     for k, one in enumerate(chosen):
         ax = fig.add_subplot(rows, cols, k + 1)
         sel = layer == one
-        ax.add_collection(LineCollection(np.stack([start[sel, :2], end[sel, :2]], axis=1),
-                                         colors=colours[sel], linewidths=0.4))
+        runs = polylines(start[sel], end[sel], colours[sel])  # one path per run of joined moves
+        ax.add_collection(LineCollection(runs.runs(), colors=colours[sel][runs.first], linewidths=0.4))
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
         ax.set_aspect("equal")
@@ -150,6 +146,17 @@ def layer_thumbnails(drawing: Drawing, count: int = THUMBNAILS) -> "Figure | Non
         ax.set_yticks([])
         ax.set_title(f"layer {int(one)}", fontsize=7)
     return fig
+
+
+def _colours(drawing: Drawing, shown: np.ndarray) -> np.ndarray:
+    """RGB of the drawing's segments ``shown`` (indices into it), on the colour scale of all its segments."""
+    path, color, segments = drawing.path, drawing.color, drawing.segments
+    work = path.kind[segments] == WORK
+    vmin, vmax = color.value_range(segments[work])
+    rgb = np.tile(hex_rgb(TRAVEL_COLOR), (shown.size, 1))
+    shown_work = work[shown]
+    rgb[shown_work] = color.rgb(color.values[segments[shown][shown_work]], vmin, vmax)
+    return rgb
 
 
 def layer_times(rows: list[dict[str, Any]], slicer_rows: list[dict[str, Any]] = ()) -> "Figure | None":
