@@ -9,7 +9,9 @@ The targets, each the ``gcodekit`` command in a fresh interpreter, end to end:
 
 Each command runs ``--repeat`` times with this checkout's ``gcodekit`` first
 on the path, the commands taking turns; the best time counts (the machine is
-shared: the load average before each run is printed and kept).  ``python -c
+shared: the load average before each run is printed and kept, and so is
+the CPU time each command and its children used, which a busy machine
+changes far less than the wall time).  ``python -c
 pass`` and ``import gcodekit`` are measured the same way, for what the
 interpreter and the package cost before any work.  No peer: no other tool
 writes these reports; the 50-line loop (``python_loop.py``) reading the
@@ -28,6 +30,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -61,15 +64,18 @@ def commands(out: str) -> list[dict]:
     ]
 
 
-def run_once(cmd: list[str]) -> tuple[float, float]:
-    """Wall time of one fresh process, and the 1-minute load average just before it."""
+def run_once(cmd: list[str]) -> tuple[float, float, float]:
+    """Wall time of one fresh process, the CPU time it and its children used (user + system: what a busy
+    machine changes least), and the 1-minute load average just before it."""
     load = os.getloadavg()[0]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run(cmd, capture_output=True, text=True, env=ENV)
     seconds = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:
         sys.exit(f"{' '.join(cmd)} failed:\n{done.stderr}")
-    return seconds, load
+    return seconds, after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime, load
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -83,23 +89,24 @@ def main(argv: list[str] | None = None) -> int:
     repeat = 2 if args.quick else args.repeat
     with tempfile.TemporaryDirectory() as out:
         cmds = commands(out)
-        runs: dict[str, list[tuple[float, float]]] = {c["name"]: [] for c in cmds}
+        runs: dict[str, list[tuple[float, float, float]]] = {c["name"]: [] for c in cmds}
         for _ in range(repeat):
             for c in cmds:
                 runs[c["name"]].append(run_once(c["cmd"]))
     rows = []
-    print(f"{'command':30}{'file':26}{'best s':>8}{'median s':>10}{'target s':>10}  load averages")
+    print(f"{'command':30}{'file':26}{'best s':>8}{'median s':>10}{'best CPU s':>12}{'target s':>10}  load averages")
     for c in cmds:
-        times = [s for s, _ in runs[c["name"]]]
-        loads = [ld for _, ld in runs[c["name"]]]
+        times = [s for s, _, _ in runs[c["name"]]]
+        cpu = [u for _, u, _ in runs[c["name"]]]
+        loads = [ld for _, _, ld in runs[c["name"]]]
         best = min(times)
         row = {"tool": c["name"], "file": c["file"], "seconds": best, "median_s": statistics.median(times),
-               "runs": times, "loads": loads, "target_s": c["target"],
+               "cpu_s": min(cpu), "runs": times, "cpu_runs": cpu, "loads": loads, "target_s": c["target"],
                "pass": None if c["target"] is None else best <= c["target"]}
         rows.append(row)
         target = "" if c["target"] is None else f"{c['target']:.1f}"
         verdict = "" if row["pass"] is None else ("PASS" if row["pass"] else "FAIL")
-        print(f"{c['name']:30}{c['file']:26}{best:8.2f}{row['median_s']:10.2f}{target:>10}  "
+        print(f"{c['name']:30}{c['file']:26}{best:8.2f}{row['median_s']:10.2f}{row['cpu_s']:12.2f}{target:>10}  "
               f"{' '.join(f'{ld:.1f}' for ld in loads)}  {verdict}")
     result = {"cpus": os.cpu_count(), "repeat": repeat, "rows": rows}
     if args.json:

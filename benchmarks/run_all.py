@@ -101,7 +101,8 @@ def startup_rows(r: dict) -> list[dict]:
     """bench_startup.py: commands end to end, imports included."""
     return [row("start-up", x["file"], x["tool"], x["seconds"], None, None,
                 f"<= {x['target_s']:g} s" if x["target_s"] is not None else "", x["pass"],
-                f"median {x['median_s']:.2f} s of {len(x['runs'])}") for x in r["rows"]]
+                f"median {x['median_s']:.2f} s of {len(x['runs'])}"
+                + (f", CPU {x['cpu_s']:.2f} s" if "cpu_s" in x else "")) for x in r["rows"]]
 
 
 def report_rows(r: dict) -> list[dict]:
