@@ -128,8 +128,8 @@ def widgets_rows(r: list) -> list[dict]:
         shown, png = x["shown_ms"] / 1000, x["peer_png_ms"] / 1000
         rows.append(row("widgets", x["file"], "PNG per step in Python (peer)", png))
         rows.append(row("widgets", x["file"], "LayerViewer step, key to frame shown", shown, None, shown / png,
-                        f"<= {x['limit_ms'] / 1000:g} s", x["shown_ms"] <= x["limit_ms"],
-                        f"VelocityPlot redrawn in {x['plot_ms']:.0f} ms"))
+                        f"<= {x['limit_ms'] / 1000:g} s, and the plot's redraw", x["pass"],
+                        f"VelocityPlot redrawn in {x['plot_ms']:.0f} ms (median of {x['steps']} steps)"))
     return rows
 
 

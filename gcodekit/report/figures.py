@@ -53,6 +53,16 @@ class Drawing:
             return np.full(self.segments.size, -1)
         return self.path.segment_group[self.segments]
 
+    @property
+    def start(self) -> np.ndarray:
+        """First end of each segment drawn, (n, 3) mm."""
+        return self.path.start[self.segments]
+
+    @property
+    def end(self) -> np.ndarray:
+        """Second end of each segment drawn, (n, 3) mm."""
+        return self.path.end[self.segments]
+
 
 def toolpath_drawing(op: "Operation", color_by: str | None = None) -> Drawing | None:
     """The report's drawing of ``op``, coloured by ``color_by`` (default: features, layers or feed); None
