@@ -83,7 +83,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--repeat", type=int, default=5, help="runs of each command, best counts (default: 5)")
     p.add_argument("--quick", action="store_true", help="smoke run: 2 runs of each")
     p.add_argument("--json", metavar="OUT", help="also write the figures as JSON")
+    p.add_argument("--checkout", type=Path, metavar="DIR",
+                   help="measure the gcodekit of another checkout (say, main's, for a before and after)")
     args = p.parse_args(argv)
+    if args.checkout:
+        ENV["PYTHONPATH"] = str(args.checkout.resolve())
     if not CYLINDER.exists():
         sys.exit(f"corpus not found: {CORPUS}")
     repeat = 2 if args.quick else args.repeat

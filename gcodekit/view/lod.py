@@ -11,7 +11,7 @@ picture and drop the rest, pure NumPy, in three steps
    sorted by height are in a true painter's order; within one height, program
    order is kept, so the moves of a layer stay one after another.  For a
    horizontal camera (``front``, ``side``) the segments are sorted by depth.
-2. *Visibility.*  Each segment is sampled every half pixel; each pixel
+2. *Visibility.*  Each segment is sampled every pixel; each pixel
    lists the segments drawn over it.  A segment that is not among the last
    few of any pixel is covered by nearer ones (or outside the picture) and
    is dropped.
@@ -30,8 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Spacing of the visibility samples along a segment, pixels.
-SAMPLE_PX = 0.5
+#: Spacing of the visibility samples along a segment, pixels (half a pixel drew plate150 no closer to its
+#: full drawing, and took a third longer).
+SAMPLE_PX = 1.0
 #: Samples handled at once (bounds the memory of a 3 M-segment picture to about 200 MB).
 CHUNK_SAMPLES = 1 << 22
 
