@@ -194,7 +194,8 @@ def draw_toolpath(ax: "Axes", path: Toolpath, color: Coloring, camera: Camera, s
     (:mod:`gcodekit.view.lod`): the same picture to the eye, drawn in a
     fraction of the time when there are many segments.
     """
-    from matplotlib.collections import LineCollection
+    from matplotlib.collections import LineCollection, PathCollection
+    from matplotlib.path import Path
 
     from .view.lod import last_drawn, painter_order, polylines
 
@@ -217,9 +218,15 @@ def draw_toolpath(ax: "Axes", path: Toolpath, color: Coloring, camera: Camera, s
         dpi = ax.figure.dpi
         size = np.array([box.width * fig_w * dpi, box.height * fig_h * dpi])
         pixels = (lines - [xlim[0], ylim[0]]) * (size / [xlim[1] - xlim[0], ylim[1] - ylim[0]])
-        runs = polylines(lines[:, 0], lines[:, 1], np.column_stack([rgb, widths]),
+        style = np.column_stack([rgb, widths])
+        runs = polylines(lines[:, 0], lines[:, 1], style,
                          last_drawn(pixels[:, 0], pixels[:, 1], *np.ceil(size).astype(int)))
-        ax.add_collection(LineCollection(runs.runs(), colors=rgb[runs.first], linewidths=widths[runs.first]))
+        vertices, starts, first = runs.batches(style[runs.first])
+        paths = [Path(v, np.where(s, Path.MOVETO, Path.LINETO).astype(Path.code_type)) for v, s in zip(vertices, starts)]
+        batch = runs.first[first]
+        # the limits are set below: no extents of every path (autolim)
+        ax.add_collection(PathCollection(paths, facecolors="none", edgecolors=rgb[batch], linewidths=widths[batch]),
+                          autolim=False)
     else:
         ax.add_collection(LineCollection(lines, colors=rgb, linewidths=widths))
     ax.set_xlim(*xlim)

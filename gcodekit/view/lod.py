@@ -11,13 +11,14 @@ picture and drop the rest, pure NumPy, in three steps
    sorted by height are in a true painter's order; within one height, program
    order is kept, so the moves of a layer stay one after another.  For a
    horizontal camera (``front``, ``side``) the segments are sorted by depth.
-2. *Visibility.*  Each segment is sampled every pixel; each pixel
+2. *Visibility.*  Each segment is sampled once a pixel; each pixel
    lists the segments drawn over it.  A segment that is not among the last
    few of any pixel is covered by nearer ones (or outside the picture) and
    is dropped.
 3. *Polylines.*  Kept segments that follow one another in that order, join
-   end to start and share a style become one polyline, so the drawing
-   library makes one path per run instead of one per segment.
+   end to start and share a style become one polyline; runs that follow one
+   another with one style are one path (the pen lifted between them), so
+   the drawing library makes a path per batch instead of one per segment.
 
 A picture drawn from the runs differs from the full drawing only where a
 dropped segment's anti-aliased edge showed beside the one over it;
@@ -62,6 +63,33 @@ class Polylines:
         """The runs as a list of (m, 2) arrays (what matplotlib's ``LineCollection`` takes)."""
         return np.split(self.vertices, self.offsets[1:-1])
 
+    def batches(self, style: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray], np.ndarray]:
+        """Consecutive runs of one style drawn as one path each: fewer, larger paths in the same order.
+
+        Parameters
+        ----------
+        style : ndarray (r,) or (r, k)
+            The style of each run.
+
+        Returns
+        -------
+        vertices : list of (m, 2) arrays
+            One per batch, its runs one after another.
+        starts : list of (m,) bool arrays
+            True where a run begins (the pen moves there without drawing).
+        first : ndarray (b,) int
+            The first run of each batch.
+        """
+        r = self.offsets.size - 1
+        new = np.ones(r, bool)
+        if r > 1:
+            new[1:] = ~(style[1:] == style[:-1]).reshape(r - 1, -1).all(axis=1)
+        first = np.flatnonzero(new)
+        begins = np.zeros(self.vertices.shape[0], bool)
+        begins[self.offsets[:-1]] = True
+        cuts = self.offsets[first[1:]]
+        return np.split(self.vertices, cuts), np.split(begins, cuts), first
+
 
 def painter_order(p0: np.ndarray, p1: np.ndarray, eye: np.ndarray) -> np.ndarray:
     """Indices of segments ``p0 -> p1`` (3D) far to near as seen along ``eye`` (towards the viewer).
@@ -90,8 +118,10 @@ def last_drawn(a: np.ndarray, b: np.ndarray, width: int, height: int, depth: int
     """
     n = a.shape[0]
     a, d = a.astype(np.float32), (b - a).astype(np.float32)
-    count = np.ceil(np.hypot(d[:, 0], d[:, 1]) / sample_px).astype(np.int64) + 1  # both ends included
-    d /= np.maximum(count - 1, 1)[:, None]  # from one sample to the next
+    # k samples at the middles of k equal parts, at most sample_px apart (one for a segment inside a pixel)
+    count = np.maximum(np.ceil(np.hypot(d[:, 0], d[:, 1]) / sample_px), 1).astype(np.int64)
+    d /= count[:, None]  # from one sample to the next
+    a += d / 2
     ends = np.cumsum(count)
     pairs = []
     lo = 0
