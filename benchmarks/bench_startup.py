@@ -75,7 +75,10 @@ def run_once(cmd: list[str]) -> tuple[float, float, float]:
     load = os.getloadavg()[0]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    done = subprocess.run(cmd, capture_output=True, text=True, env=ENV)
+    # run from an empty folder: ``python -c`` and ``-m`` put the current directory first on the path,
+    # where a checkout would take the place of the one measured
+    with tempfile.TemporaryDirectory() as cwd:
+        done = subprocess.run(cmd, capture_output=True, text=True, env=ENV, cwd=cwd)
     seconds = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:
