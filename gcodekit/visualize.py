@@ -222,7 +222,8 @@ def draw_toolpath(ax: "Axes", path: Toolpath, color: Coloring, camera: Camera, s
         runs = polylines(lines[:, 0], lines[:, 1], style,
                          last_drawn(pixels[:, 0], pixels[:, 1], *np.ceil(size).astype(int)))
         vertices, starts, first = runs.batches(style[runs.first])
-        paths = [Path(v, np.where(s, Path.MOVETO, Path.LINETO).astype(Path.code_type)) for v, s in zip(vertices, starts)]
+        paths = [Path(v, np.where(s, Path.MOVETO, Path.LINETO).astype(Path.code_type))
+                 for v, s in zip(vertices, starts)]
         batch = runs.first[first]
         # the limits are set below: no extents of every path (autolim)
         ax.add_collection(PathCollection(paths, facecolors="none", edgecolors=rgb[batch], linewidths=widths[batch]),
