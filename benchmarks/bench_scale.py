@@ -26,6 +26,7 @@ the file's lines.
     python benchmarks/bench_scale.py                      # plate150 and the cylinder, 3 runs each
     python benchmarks/bench_scale.py --big                # and the 30 M-line file (one run each)
     python benchmarks/bench_scale.py --json out.json      # records: tool, file, seconds, peak_mb, bytes_per_line, lines
+    python benchmarks/bench_scale.py --quick              # smoke run: the cylinder, once
 """
 
 from __future__ import annotations
@@ -147,12 +148,15 @@ def main(argv=None) -> int:
     parser.add_argument("--big", action="store_true", help="also the 30 M-line file (one run of each tool)")
     parser.add_argument("--skip-cylinder", action="store_true")
     parser.add_argument("--file", type=Path, help="measure this file instead of plate150")
+    parser.add_argument("--quick", action="store_true", help="a smoke run: the cylinder alone, once")
     parser.add_argument("--json", type=Path, metavar="OUT", help="write the records as JSON")
     args = parser.parse_args(argv)
     if args.child:
         print(json.dumps(child(*args.child)))
         return 0
     files = [args.file or PLATE] + ([] if args.skip_cylinder or args.file else [CYLINDER])
+    if args.quick:
+        files, args.repeat, args.big = [CYLINDER], 1, False
     records = []
     for path in files:
         print(f"{path.name}:", file=sys.stderr)
