@@ -100,8 +100,11 @@ def browser_page(width: int = 1400, height: int = 1000):
             browser.close()
 
 
-def open_and_run(page, url: str, notebook: str, timeout_s: float = 240.0) -> None:
-    """Open ``notebook`` in JupyterLab and run all its cells, waiting until none is busy."""
+def open_and_run(page, url: str, notebook: str, timeout_s: float = 240.0, before_run=None) -> None:
+    """Open ``notebook`` in JupyterLab and run all its cells, waiting until none is busy.
+
+    ``before_run(page)``, when given, is called once the kernel is idle, just before the cells run.
+    """
     page.goto(f"{url}/lab/tree/{notebook}?reset")
     page.wait_for_function("window.jupyterapp && document.querySelector('.jp-NotebookPanel .jp-Cell')",
                            timeout=timeout_s * 1000)
@@ -109,6 +112,8 @@ def open_and_run(page, url: str, notebook: str, timeout_s: float = 240.0) -> Non
     page.wait_for_function("document.querySelector('.jp-NotebookPanel') && "
                            "window.jupyterapp.shell.currentWidget?.sessionContext?.session?.kernel?.status === 'idle'",
                            timeout=timeout_s * 1000)
+    if before_run is not None:
+        before_run(page)
     page.evaluate("window.jupyterapp.commands.execute('notebook:run-all-cells')")
     page.wait_for_timeout(500)
     page.wait_for_function(
