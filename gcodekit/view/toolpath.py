@@ -227,22 +227,23 @@ def move_segments(w: dict, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np
     """
     from ..emulate.arcs import waypoint_arc_points
 
-    xyz = np.column_stack([np.asarray(w[k], float) for k in "xyz"])
     interior, counts = waypoint_arc_points(w, rows, np.radians(CHORD_ANGLE_DEG))
-    points_per_move = counts + 2  # its start, the arc's interior points, its end
-    offsets = np.r_[0, np.cumsum(points_per_move)]
-    points = np.empty((int(offsets[-1]), 3))
-    points[offsets[:-1]] = xyz[rows - 1]
-    points[offsets[1:] - 1] = xyz[rows]
-    inside = np.ones(points.shape[0], bool)
-    inside[offsets[:-1]] = inside[offsets[1:] - 1] = False
-    points[inside] = interior
-    # a segment joins each point to the next one of the same move
-    joins = np.ones(points.shape[0], bool)
-    joins[offsets[1:] - 1] = False
-    seg_start = np.flatnonzero(joins)
-    move_of = np.repeat(np.arange(rows.size), points_per_move - 1)
-    return points[seg_start], points[seg_start + 1], move_of
+    before = np.column_stack([np.asarray(w[k], float)[rows - 1] for k in "xyz"])
+    after = np.column_stack([np.asarray(w[k], float)[rows] for k in "xyz"])
+    if interior.shape[0] == 0:  # no arcs: one segment per move
+        return before, after, np.arange(rows.size)
+    # a move's segments join its start, the arc's interior points and its end, in order
+    offsets = np.r_[0, np.cumsum(counts + 1)]
+    first, last = offsets[:-1], offsets[1:] - 1
+    start, end = np.empty((int(offsets[-1]), 3)), np.empty((int(offsets[-1]), 3))
+    start[first], end[last] = before, after
+    inside = np.ones(start.shape[0], bool)
+    inside[first] = False
+    start[inside] = interior  # every segment but a move's first starts at an interior point
+    inside[:] = True
+    inside[last] = False
+    end[inside] = interior  # and every one but its last ends at one
+    return start, end, np.repeat(np.arange(rows.size), counts + 1)
 
 
 
