@@ -97,11 +97,18 @@ def choices(path: Toolpath) -> list[str]:
     named += ["time", "tool"]
     if op.process == "additive":
         named.append("flow")
-    rows = path.move_rows
-    # a column that never changes over the moves would paint everything one colour
+    moves = np.zeros(len(op.waypoints["x"]), bool)
+    moves[path.move_rows] = True
+    # a column that never changes over the moves would paint everything one colour (reduced in place: no copies)
     columns = sorted(k for k, v in op.waypoints.items()
-                     if k not in HIDDEN and k not in named and np.ptp(np.asarray(v, float)[rows]) > 0)
+                     if k not in HIDDEN and k not in named and _varies(np.asarray(v), moves))
     return named + columns
+
+
+def _varies(values: np.ndarray, where: np.ndarray) -> bool:
+    if values.dtype.kind != "f":
+        values = values.astype(float)
+    return bool(values.max(where=where, initial=-np.inf) > values.min(where=where, initial=np.inf))
 
 
 @dataclass

@@ -2,12 +2,14 @@
 
 A large print has millions of short segments, several times more than a
 view has pixels.  :func:`overview` cuts the toolpath into runs (connected
-segments of one key: group, kind and colour, combined by the caller) and
-draws each run as chords through every ``stride``-th point of it, the
-smallest stride that fits the budget.  A run's chords start at its first
-point and end at its last, so its ends, its corners at the stride's points
-and everything about it but the detail between them stay; chords never
-join two runs, so the colours stay exact.  The chords are a partition of
+segments of one key: group, kind and colour, combined by the caller, that
+turn by at most :data:`CORNER_DEG` at each joint) and draws each run as
+chords through every ``stride``-th point of it, the smallest stride that
+fits the budget.  A run's chords start at its first point and end at its
+last, so its ends and every sharper corner stay (an infill's zigzag keeps
+its shape) and the chords cut only gentle curves shorter, such as a
+perimeter's many short chords of a circle; chords never join two runs, so
+the colours stay exact.  The chords are a partition of
 the toolpath's segments in program order: a group range is still one
 contiguous slice.  Only when the runs alone outnumber the budget are evenly
 spaced chords left out.
@@ -15,6 +17,9 @@ spaced chords left out.
 Examples
 --------
 >>> import numpy as np
+
+#: A run of segments ends where the path turns by more than this (degrees): corners stay corners.
+CORNER_DEG = 45.0
 >>> p = np.column_stack([np.arange(9.0), np.zeros(9), np.zeros(9)])  # 8 segments along X
 >>> first, last = chords(p[:-1], p[1:], np.r_[np.zeros(6, int), 1, 1], stride=4)
 >>> first.tolist(), last.tolist()  # two runs: segments 0-5 (in chords of 4 and 2), 6-7
@@ -25,14 +30,22 @@ from __future__ import annotations
 
 import numpy as np
 
+#: A run of segments ends where the path turns by more than this (degrees): corners stay corners.
+CORNER_DEG = 45.0
+
 
 def runs(start: np.ndarray, end: np.ndarray, key: np.ndarray) -> np.ndarray:
-    """First segment of each run: where the key (n,) or (n, k) changes or a segment does not start at the one before's end."""
+    """First segment of each run: where the key (n,) or (n, k) changes, the path turns by more than
+    :data:`CORNER_DEG` or a segment does not start at the one before's end."""
     n = start.shape[0]
     if n == 0:
         return np.zeros(0, np.int64)
     same = key[1:] == key[:-1]
     joined = (np.all(same, axis=1) if same.ndim == 2 else same) & np.all(end[:-1] == start[1:], axis=1)
+    d = end - start
+    length = np.sqrt(np.einsum("ij,ij->i", d, d))
+    # cos(turn) * |a| |b| = a . b: no division (zero-length segments then end no run)
+    joined &= np.einsum("ij,ij->i", d[:-1], d[1:]) >= np.cos(np.radians(CORNER_DEG)) * length[:-1] * length[1:]
     return np.flatnonzero(np.r_[True, ~joined])
 
 

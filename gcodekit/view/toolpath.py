@@ -171,11 +171,19 @@ class Toolpath:
         Travel to a parking or home position would otherwise shrink the part to a dot.
         """
         if keep is None:
-            keep = self.kind == WORK if (self.kind == WORK).any() else slice(None)
-        both = np.vstack([self.start[keep], self.end[keep]])
-        if both.size == 0:
-            return np.zeros(3), np.zeros(3)
-        return both.min(axis=0), both.max(axis=0)
+            return tuple(a.copy() for a in self._work_bounds)
+        return _corners(self.start[keep], self.end[keep])
+
+    @cached_property
+    def _work_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        work = self.kind == WORK
+        if not work.any():
+            return _corners(self.start, self.end)
+        # reduced in place (a copy of millions of selected points costs more than the reduction)
+        mask = work[:, None]
+        lo = [p.min(axis=0, where=mask, initial=np.inf) for p in (self.start, self.end)]
+        hi = [p.max(axis=0, where=mask, initial=-np.inf) for p in (self.start, self.end)]
+        return np.minimum(*lo), np.maximum(*hi)
 
     def frame(self) -> tuple[np.ndarray, float]:
         """Centre of :meth:`bounds` and the radius of the sphere around them, mm."""
@@ -187,6 +195,12 @@ class Toolpath:
         w = self.op.waypoints
         end = self.op.elapsed_time()[self.move_rows]
         return end - np.nan_to_num(np.asarray(w["time"], float)[self.move_rows]), end
+
+
+def _corners(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    if start.shape[0] == 0:
+        return np.zeros(3), np.zeros(3)
+    return np.minimum(start.min(axis=0), end.min(axis=0)), np.maximum(start.max(axis=0), end.max(axis=0))
 
 
 def _command_rows(op: "Operation") -> np.ndarray:

@@ -129,7 +129,7 @@ class VelocityPlot(PictureDisplay):
             self._waypoint, self.corners = op.plan[0].waypoint, 4
         else:
             self._waypoint, self.corners = np.flatnonzero(np.asarray(op.waypoints["motion"]) > 0), 2
-        self.ymax = float(np.nanmax(np.r_[self.planned, self.commanded, 1e-9])) * 1.05
+        self.ymax = float(np.fmax.reduce([np.fmax.reduce(self.planned), np.fmax.reduce(self.commanded), 1e-9])) * 1.05
         work, travel = move_masks(op)
         self._move_rows = np.flatnonzero(work | travel)  # the toolpath's moves (Toolpath.move_rows)
 
