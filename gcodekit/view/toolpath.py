@@ -56,6 +56,26 @@ def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
     return work, moving & ~work
 
 
+def move_rows(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
+    """Waypoint rows that end a move (the moves every picture draws), and :func:`move_masks`' work mask.
+
+    Raises
+    ------
+    ToolpathError
+        When the operation is not emulated or has no motion to draw.
+    """
+    w = getattr(op, "waypoints", None)
+    if w is None:
+        raise ToolpathError(f"{op.file}: the operation is not emulated (use gcode_to_operation)")
+    if len(w["x"]) == 0:
+        raise ToolpathError(f"{op.file}: nothing to draw (the program is empty: no commands to run)")
+    work, travel = move_masks(op)
+    rows = np.flatnonzero(work | travel)
+    if rows.size == 0:
+        raise ToolpathError(f"{op.file}: nothing to draw (the program has no motions)")
+    return rows, work
+
+
 @dataclass
 class Toolpath:
     """Segments of an emulated operation, in program order.
@@ -110,17 +130,9 @@ class Toolpath:
         op = getattr(source, "operation", source)  # an AdditivePart draws its operation with its layers
         waypoint_layer = getattr(source, "waypoint_layer", None)
         w = getattr(op, "waypoints", None)
-        if w is None:
-            raise ToolpathError(f"{op.file}: the operation is not emulated (use gcode_to_operation)")
-        if len(w["x"]) == 0:
-            raise ToolpathError(f"{op.file}: nothing to draw (the program is empty: no commands to run)")
-        work, travel = move_masks(op)
-        moving = work | travel
-        if not moving.any():
-            raise ToolpathError(f"{op.file}: nothing to draw (the program has no motions)")
+        rows, work = move_rows(op)
         group_by = group_by or ("layer" if op.process == "additive" else "z")
         check_choice("group_by", group_by, GROUP_BY)
-        rows = np.flatnonzero(moving)
         key, labels = _group_keys(op, rows, work[rows], group_by, waypoint_layer)
         start, end, move_of = move_segments(w, rows)
         group_move = np.searchsorted(key, np.arange(len(labels) + 1))

@@ -17,7 +17,7 @@ import ipywidgets as widgets
 import numpy as np
 import traitlets
 
-from ..view import Toolpath, ToolpathError, move_masks, source_lines
+from ..view import Toolpath, ToolpathError, move_rows, source_lines
 from .display import PictureDisplay, friendly, message_html
 from .picture import message_figure, new_figure
 from .toolpath import load_source
@@ -114,8 +114,7 @@ class VelocityPlot(PictureDisplay):
         from ..analysis import velocity_corners
 
         op = getattr(self.source, "operation", self.source)
-        if getattr(op, "waypoints", None) is None:
-            raise ToolpathError(f"{op.file}: the operation is not emulated (use gcode_to_operation)")
+        self._move_rows, _ = move_rows(op)  # the toolpath's moves (Toolpath.move_rows), or why there are none
         self.op = op
         corners = velocity_corners(op)
         if corners["time"].size == 0:
@@ -130,8 +129,6 @@ class VelocityPlot(PictureDisplay):
         else:
             self._waypoint, self.corners = np.flatnonzero(np.asarray(op.waypoints["motion"]) > 0), 2
         self.ymax = float(np.fmax.reduce([np.fmax.reduce(self.planned), np.fmax.reduce(self.commanded), 1e-9])) * 1.05
-        work, travel = move_masks(op)
-        self._move_rows = np.flatnonzero(work | travel)  # the toolpath's moves (Toolpath.move_rows)
 
     def moves_of(self, points: np.ndarray) -> np.ndarray:
         """The toolpath move (index of ``path.move_rows``) of each of the profile's points ``points``."""
