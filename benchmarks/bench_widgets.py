@@ -158,8 +158,12 @@ def browser_steps(program: Path, steps: int, pause_ms: int) -> dict:
                 marks["start"] = traffic.bytes
 
             open_and_run(page, url, "bench.ipynb", before_run=before_run)
-            page.wait_for_selector(".gk-status[data-frame]", state="attached", timeout=120_000)
-            page.wait_for_selector(".gk-plot-status[data-frame]", state="attached", timeout=120_000)
+            try:
+                page.wait_for_selector(".gk-status[data-frame]", state="attached", timeout=120_000)
+                page.wait_for_selector(".gk-plot-status[data-frame]", state="attached", timeout=120_000)
+            except Exception as exc:
+                outputs = page.locator(".jp-OutputArea-output").all_inner_texts()
+                raise RuntimeError(f"no picture: cell outputs {outputs}, console errors {page.console_errors}") from exc
             page.wait_for_timeout(1000)
             opened = page.evaluate("window.gkOpen")
             times = page.locator(".jp-OutputArea-output:has-text('gk-times')").inner_text().split()

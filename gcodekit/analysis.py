@@ -25,7 +25,7 @@ from .model.derived import depositing, depositing_of, features, layers, row_labe
 from .model.statistics import operation_statistics
 from .parse.table import NAME_ID as NAME_ID_LOOKUP
 
-__all__ = ["time_by", "slicer_layer_times", "velocity_profile", "part_name", "tool_vectors", "ded_moves", "depositing", "depositing_of",
+__all__ = ["time_by", "slicer_layer_times", "velocity_profile", "velocity_corners", "part_name", "tool_vectors", "ded_moves", "depositing", "depositing_of",
            "features", "layers", "screw_extruder", "waypoint_rows", "operation_statistics", "event_series",
            "gcode_dataframe_to_event_series"]
 

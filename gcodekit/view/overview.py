@@ -8,8 +8,9 @@ chords through every ``stride``-th point of it, the smallest stride that
 fits the budget.  A run's chords start at its first point and end at its
 last, so its ends and every sharper corner stay (an infill's zigzag keeps
 its shape) and the chords cut only gentle curves shorter, such as a
-perimeter's many short chords of a circle; chords never join two runs, so
-the colours stay exact.  The chords are a partition of
+perimeter's many short chords of a circle (a small circle then shows as a
+polygon of a few chords: the top layer, drawn from its own segments, shows
+it round); chords never join two runs, so the colours stay exact.  The chords are a partition of
 the toolpath's segments in program order: a group range is still one
 contiguous slice.  Only when the runs alone outnumber the budget are evenly
 spaced chords left out.
@@ -17,9 +18,6 @@ spaced chords left out.
 Examples
 --------
 >>> import numpy as np
-
-#: A run of segments ends where the path turns by more than this (degrees): corners stay corners.
-CORNER_DEG = 45.0
 >>> p = np.column_stack([np.arange(9.0), np.zeros(9), np.zeros(9)])  # 8 segments along X
 >>> first, last = chords(p[:-1], p[1:], np.r_[np.zeros(6, int), 1, 1], stride=4)
 >>> first.tolist(), last.tolist()  # two runs: segments 0-5 (in chords of 4 and 2), 6-7

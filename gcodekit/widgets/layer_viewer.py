@@ -16,6 +16,7 @@ and one layer's segments (33 bytes each, 4 per move) per layer visited.
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import threading
 from pathlib import Path
@@ -325,15 +326,32 @@ class LayerViewer(PictureDisplay):
         return False
 
     def figure(self, size: tuple[int, int] = (800, 600)):
-        """The current picture as a matplotlib Figure (what :meth:`screenshot` returns)."""
+        """The current picture as a matplotlib Figure (what :meth:`screenshot` returns).
+
+        A program sent as an overview is drawn from the overview's chords (as
+        the browser draws it before a layer's own segments arrive).
+        """
         if self.error is not None:
             return message_figure(self.error)
         lo, hi = self.layers.value
+        labels = self.path.group_labels
         name = Path(self.path.op.file).name
-        what = self.path.group_labels[lo] if lo == hi else f"{self.path.group_labels[lo]} to {self.path.group_labels[hi]}"
-        return toolpath_figure(self.path, self.span, self._coloring, self.camera, show_travel=self.travel.value,
-                               current_move=self.current_move, size=size,
+        what = labels[lo] if lo == hi else f"{labels[lo]} to {labels[hi]}"
+        path, color = self._drawn()
+        return toolpath_figure(path, path.group_slice(lo, hi, self.moves.value), color, self.camera,
+                               show_travel=self.travel.value, current_move=self.current_move, size=size,
                                title=f"{name}: {what}, move {self.moves.value + 1} of {self.moves.max + 1}")
+
+    def _drawn(self) -> tuple[Toolpath, Coloring]:
+        """The toolpath and colouring pictures draw: the program's, or its overview's chords as a Toolpath."""
+        if self.view.stride == 1:
+            return self.path, self._coloring
+        first, last = self._chords
+        p = self.path
+        move_of = p.move_of[first]
+        chords = dataclasses.replace(p, start=p.start[first], end=p.end[last], move_of=move_of, kind=p.kind[first],
+                                     move_seg=np.searchsorted(move_of, np.arange(p.move_rows.size + 1)))
+        return chords, dataclasses.replace(self._coloring, values=self._coloring.values[first])
 
     def __repr__(self) -> str:
         if self.error is not None:
