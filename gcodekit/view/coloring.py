@@ -59,10 +59,14 @@ def waypoint_scalars(op: "Operation", by: str) -> tuple[np.ndarray, list[str] | 
     """
     w = op.waypoints
     if by == "feature":
-        import pandas as pd
+        features = np.asarray(op.features, dtype=object)
+        if features.size < 200_000:  # pandas' import costs more than sorting these
+            names, codes = np.unique(features.astype(str), return_inverse=True)
+        else:
+            import pandas as pd
 
-        # np.unique's sorted names and codes, by hashing the names (sorting 3 M strings took seconds)
-        codes, names = pd.factorize(np.asarray(op.features, dtype=object), sort=True)
+            # np.unique's sorted names and codes, by hashing the names (sorting 3 M strings took seconds)
+            codes, names = pd.factorize(features, sort=True)
         return codes.astype(np.int32), [n or NO_FEATURE for n in names.tolist()]
     if by == "speed":
         d, t = np.asarray(w["distance"], float), np.nan_to_num(np.asarray(w["time"], float))
