@@ -81,6 +81,7 @@ class VelocityPlot(PictureDisplay):
         self.error: str | None = None
         self.source = None
         self._path: Toolpath | None = None
+        self._move_times: tuple[np.ndarray, np.ndarray] | None = None
         self._linked = None
         self.view = VelocityView(height=height, x_label=X_LABELS[x], layout=widgets.Layout(width="100%"))
         self.picked = widgets.HTML()
@@ -177,7 +178,9 @@ class VelocityPlot(PictureDisplay):
 
     def show_moves(self, first: int, last: int) -> None:
         """Show the moves ``first..last`` (indices of the toolpath's moves)."""
-        start, end = self.path.times()
+        if self._move_times is None:  # a slider step asks again: the toolpath's times once
+            self._move_times = self.path.times()
+        start, end = self._move_times
         t0, t1 = start[first], end[last]
         if self.x_name == "distance":
             t0, t1 = np.interp([t0, t1], self.times, self.xs)
