@@ -1,6 +1,6 @@
 """Widgets stage: VelocityPlot, commanded feed against the planner's speed.
 
-The profile (:func:`gcodekit.analysis.velocity_profile`, four corners per
+The profile (:func:`gcodekit.analysis.velocity_corners`, four corners per
 planned move) can hold half a million points; the browser gets at most a
 few thousand for the range shown: every corner when they fit, else the
 lowest and highest speed per bin (a line plot drawn at pixel density looks
