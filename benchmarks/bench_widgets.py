@@ -237,21 +237,30 @@ def main(argv=None) -> int:
     parser.add_argument("--steps", type=int, default=30)
     parser.add_argument("--pause", type=int, default=400, help="ms between key presses (default: 400)")
     parser.add_argument("--peer-steps", type=int, default=3, help="steps drawn as PNGs by the peer (0: none)")
-    parser.add_argument("--json", type=Path, help="also write every figure here")
+    parser.add_argument("--quick", action="store_true", help="smoke run: cube20 only, 5 steps each way")
+    parser.add_argument("--json", metavar="OUT", type=Path,
+                        help="also write each program's medians and figures here (a list, as run_all.py reads it)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.files, args.steps = [FILES[1]], 5
     t0 = time.perf_counter()
     import gcodekit  # noqa: F401
 
     print(f"import gcodekit: {(time.perf_counter() - t0) * 1000:.0f} ms")
-    failed, results = False, {}
+    failed, figures = False, []
     for program in args.files:
         r = browser_steps(program, args.steps, args.pause)
         png = peer_png(program, args.peer_steps) if args.peer_steps else []
-        failed |= not report(program, r, png)
-        results[program.name] = {**r, "peer_png_ms": png}
+        ok = report(program, r, png)
+        failed |= not ok
+        med = {k: statistics.median(r[k]) if r[k] else float("nan") for k in ("drawn", "shown", "detailed", "plot")}
+        figures.append({"file": program.name, "steps": len(r["drawn"]), "segments": r["segments"],
+                        **{f"{k}_ms": med[k] for k in med},
+                        "peer_png_ms": statistics.median(png) if png else float("nan"), "limit_ms": LIMIT_MS,
+                        "open_limit_s": OPEN_LIMIT_S, "pass": ok, **r, "peer_png_all_ms": png})
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(results, indent=1))
+        args.json.write_text(json.dumps(figures, indent=2) + "\n")
     return 1 if failed else 0
 
 

@@ -188,6 +188,7 @@ class Toolpath:
 
     @cached_property
     def _work_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`bounds` of the work, once: every picture and camera asks."""
         work = self.kind == WORK
         if not work.any():
             return _corners(self.start, self.end)
