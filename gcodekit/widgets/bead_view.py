@@ -1,0 +1,125 @@
+"""Front end: the beads an additive program lays, as shaded tubes in a live 3D view (trame, vtk.js), with a slider.
+
+The beads are :func:`gcodekit.additive.bead_tubes` of the program's
+:class:`~gcodekit.additive.AdditivePart` (its bead geometry: width, height
+and shape per deposition segment), built once in program order.  The
+slider over the depositing moves shows the beads laid up to the chosen
+move: a step hands vtk.js the first triangles of that mesh, never building
+geometry again, and its points (which do not change) are not sent again
+(trame sends an array only when its content changed).  Colours: the
+slicer's features when the program names them, else the layers.
+
+Every VTK and trame call runs on the thread of the trame server's loop
+(:mod:`gcodekit.widgets.trame_view`); the display also carries a PNG.
+
+Examples
+--------
+::
+
+    view = gcodekit.widgets.BeadView(gcodekit.gcode_to_operation("part.gcode"))
+    view            # in JupyterLab: the beads, a slider over the depositing moves
+    view.show_move(500)
+"""
+
+from __future__ import annotations
+
+import html
+
+import numpy as np
+
+from ..additive import AdditivePart, Bead, bead_tubes
+from ..view.coloring import NO_FEATURE, PALETTE, has_features, waypoint_scalars
+from .trame_view import TrameView
+
+#: The view's background.
+BACKGROUND = "white"
+
+
+class BeadView(TrameView):
+    """The beads an additive program lays, in a 3D view the user rotates, and a slider over its depositing moves.
+
+    Parameters
+    ----------
+    op : Operation
+        An emulated additive operation.
+    bead : Bead, default: None
+        The cross-section (as for :class:`~gcodekit.additive.AdditivePart`);
+        None: from the program (filament per mm and layer spacing).
+    layers : (int, int), default: None
+        Only these layers (first, last; both included); None: all.
+    sides : int, default: 8
+        Points on each bead's outline.
+    size : (int, int), default: (800, 520)
+        The view's width and height, pixels.
+    """
+
+    def __init__(self, op, *, bead: Bead | None = None, layers: tuple[int, int] | None = None, sides: int = 8,
+                 size: tuple[int, int] = (800, 520)):
+        self.op = op
+        self.part = AdditivePart(op, bead)
+        self.tubes = bead_tubes(self.part, sides=sides, layers=layers)
+        if self.tubes.triangles.size == 0:
+            raise ValueError(f"{op.file}: no beads to show (the program lays no material"
+                             f"{' in those layers' if layers is not None else ''})")
+        self.rows = np.unique(self.tubes.triangle_row)
+        self._counts = np.searchsorted(self.tubes.triangle_row, self.rows, side="right")
+        self._faces = np.column_stack([np.full(len(self.tubes.triangles), 3, np.int64),
+                                       self.tubes.triangles]).ravel()
+        if has_features(op):
+            self.color_by = "feature"
+            codes, self.categories = waypoint_scalars(op, "feature")
+            self._values = codes[self.tubes.point_row].astype(float)
+        else:
+            self.color_by, self.categories = "layer", None
+            self._values = np.asarray(self.part.waypoint_layer, float)[self.tubes.point_row]
+        volume = np.nan_to_num(np.asarray(op.volumes(), float))
+        self._laid = np.cumsum(np.where(self.part.operation.work, volume, 0.0))
+        self.mesh = None
+        super().__init__(int(self.rows.size), size, "bead")
+
+    def __repr__(self) -> str:
+        return f"BeadView of {self.op.file}: {self.rows.size} depositing moves, {len(self.tubes.triangles):,} triangles"
+
+    # -- the scene ----------------------------------------------------------------------------
+
+    def _polydata(self, move: int):
+        mesh = self.tubes.polydata(int(self._counts[move - 1]))
+        mesh.point_data["color"] = self._values
+        return mesh
+
+    def _scene(self, plotter) -> None:
+        mesh = self._polydata(self.move)
+        if plotter is self.plotter:
+            self.mesh = mesh  # the live view's, whose faces a step changes
+        plotter.set_background(BACKGROUND)
+        if self.categories is not None:
+            n = len(self.categories)
+            cmap = [PALETTE[k % len(PALETTE)] for k in range(n)]
+            plotter.add_mesh(mesh, scalars="color", cmap=cmap, clim=[-0.5, n - 0.5], n_colors=n,
+                             show_scalar_bar=False, name="beads")
+        else:
+            top = float(np.max(self._values)) if self._values.size else 0.0
+            plotter.add_mesh(mesh, scalars="color", cmap="viridis", clim=[0.0, max(top, 1.0)], show_scalar_bar=True, name="beads",
+                             scalar_bar_args=dict(title="layer", color="black", vertical=True, position_x=0.88,
+                                                  position_y=0.1, height=0.8, width=0.04))
+        # the whole part framed, whatever move is shown; shaded smoothly by the tubes' own normals
+        plotter.view_isometric()
+        lo, hi = self.tubes.points.min(axis=0), self.tubes.points.max(axis=0)
+        plotter.reset_camera(bounds=[lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]])
+
+    def _update(self, move: int) -> None:
+        count = int(self._counts[move - 1])
+        self.mesh.faces = self._faces[:4 * count]
+
+    def _status(self, move: int) -> str:
+        row = int(self.rows[move - 1])
+        op = self.op
+        line = int(op.table.line[op.waypoints["command"][row]])
+        layer = int(self.part.waypoint_layer[row])
+        legend = ""
+        if self.categories is not None:
+            shown = np.unique(self._values[:]).astype(int)
+            legend = " · " + " ".join(
+                f'<span style="color:{PALETTE[k % len(PALETTE)]}">■</span> {html.escape(self.categories[k])}'
+                for k in shown if self.categories[k] != NO_FEATURE)
+        return f"line {line} · layer {layer} · laid {self._laid[row]:,.1f} mm³{legend}"
