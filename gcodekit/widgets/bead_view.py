@@ -33,6 +33,21 @@ from .trame_view import TrameView
 
 #: The view's background.
 BACKGROUND = "white"
+#: Triangles per block (about): a block is one actor, and a slider step sends vtk.js only the blocks whose
+#: share of the beads changes (within a block: the block the move ends in).
+BLOCK_TRIANGLES = 8_000
+
+
+def _blocks(counts: np.ndarray, size: int) -> np.ndarray:
+    """Triangle indices where blocks start (and the end): a block ends at the end of the first move that
+    brings it to ``size`` triangles or more."""
+    bounds = [0]
+    for end in counts.tolist():
+        if end - bounds[-1] >= size:
+            bounds.append(end)
+    if bounds[-1] != counts[-1]:
+        bounds.append(int(counts[-1]))
+    return np.asarray(bounds, np.int64)
 
 
 class BeadView(TrameView):
@@ -63,8 +78,7 @@ class BeadView(TrameView):
                              f"{' in those layers' if layers is not None else ''})")
         self.rows = np.unique(self.tubes.triangle_row)
         self._counts = np.searchsorted(self.tubes.triangle_row, self.rows, side="right")
-        self._faces = np.column_stack([np.full(len(self.tubes.triangles), 3, np.int64),
-                                       self.tubes.triangles]).ravel()
+        self._bounds = _blocks(self._counts, BLOCK_TRIANGLES)
         if has_features(op):
             self.color_by = "feature"
             codes, self.categories = waypoint_scalars(op, "feature")
@@ -74,7 +88,7 @@ class BeadView(TrameView):
             self._values = np.asarray(self.part.waypoint_layer, float)[self.tubes.point_row]
         volume = np.nan_to_num(np.asarray(op.volumes(), float))
         self._laid = np.cumsum(np.where(self.part.operation.work, volume, 0.0))
-        self.mesh = None
+        self._shown: list[int] = []  # triangles each block's actor shows in the live view
         super().__init__(int(self.rows.size), size, "bead")
 
     def __repr__(self) -> str:
@@ -82,34 +96,68 @@ class BeadView(TrameView):
 
     # -- the scene ----------------------------------------------------------------------------
 
-    def _polydata(self, move: int):
-        mesh = self.tubes.polydata(int(self._counts[move - 1]))
-        mesh.point_data["color"] = self._values
+    def _block_mesh(self, k: int):
+        """Block ``k``'s triangles as a mesh of its own points (with their normals, colour values, waypoints)."""
+        from ..additive.tubes import faces_array
+        from ..export.vtk import import_pyvista
+
+        pv = import_pyvista()
+        lo, hi = self._bounds[k], self._bounds[k + 1]
+        triangles = self.tubes.triangles[lo:hi]
+        used, local = np.unique(triangles, return_inverse=True)
+        mesh = pv.PolyData(self.tubes.points[used], faces=faces_array(local.reshape(-1, 3)))
+        mesh.point_data["Normals"] = self.tubes.normals[used]
+        mesh.point_data.active_normals_name = "Normals"
+        mesh.point_data["waypoint"] = self.tubes.point_row[used]
+        mesh.point_data["color"] = self._values[used]
         return mesh
 
     def _scene(self, plotter) -> None:
-        mesh = self._polydata(self.move)
-        if plotter is self.plotter:
-            self.mesh = mesh  # the live view's, whose faces a step changes
         plotter.set_background(BACKGROUND)
-        if self.categories is not None:
-            n = len(self.categories)
-            cmap = [PALETTE[k % len(PALETTE)] for k in range(n)]
-            plotter.add_mesh(mesh, scalars="color", cmap=cmap, clim=[-0.5, n - 0.5], n_colors=n,
-                             show_scalar_bar=False, name="beads")
-        else:
-            top = float(np.max(self._values)) if self._values.size else 0.0
-            plotter.add_mesh(mesh, scalars="color", cmap="viridis", clim=[0.0, max(top, 1.0)], show_scalar_bar=True, name="beads",
+        live = plotter is self.plotter
+        count = int(self._counts[self.move - 1])
+        self._faces: list[np.ndarray] = []
+        for k in range(len(self._bounds) - 1):
+            mesh = self._block_mesh(k)
+            if self.categories is not None:
+                n = len(self.categories)
+                style = dict(cmap=[PALETTE[c % len(PALETTE)] for c in range(n)], clim=[-0.5, n - 0.5], n_colors=n,
+                             show_scalar_bar=False)
+            else:
+                top = float(np.max(self._values)) if self._values.size else 0.0
+                style = dict(cmap="viridis", clim=[0.0, max(top, 1.0)], show_scalar_bar=k == 0,
                              scalar_bar_args=dict(title="layer", color="black", vertical=True, position_x=0.88,
                                                   position_y=0.1, height=0.8, width=0.04))
+            actor = plotter.add_mesh(mesh, scalars="color", name=f"beads{k}", **style)
+            if live:
+                self._faces.append(mesh.faces.copy())
+            self._show_block(actor, k, count, mesh.faces.copy())
+        if live:
+            self._shown = [self._in_block(k, count) for k in range(len(self._bounds) - 1)]
         # the whole part framed, whatever move is shown; shaded smoothly by the tubes' own normals
         plotter.view_isometric()
         lo, hi = self.tubes.points.min(axis=0), self.tubes.points.max(axis=0)
         plotter.reset_camera(bounds=[lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]])
 
+    def _in_block(self, k: int, count: int) -> int:
+        """How many of block ``k``'s triangles the first ``count`` triangles take."""
+        return int(np.clip(count - self._bounds[k], 0, self._bounds[k + 1] - self._bounds[k]))
+
+    def _show_block(self, actor, k: int, count: int, faces: np.ndarray) -> None:
+        """Show block ``k``'s share of the first ``count`` triangles (``faces``: all of the block's)."""
+        shown = self._in_block(k, count)
+        actor.visibility = shown > 0
+        if shown and actor.mapper.dataset.n_cells != shown:
+            actor.mapper.dataset.faces = faces[:4 * shown]
+
     def _update(self, move: int) -> None:
+        # only the blocks whose share changes are touched: those wholly before or after the move stay as they
+        # are, and vtk.js is sent nothing for them but (at most) their visibility
         count = int(self._counts[move - 1])
-        self.mesh.faces = self._faces[:4 * count]
+        for k, before in enumerate(self._shown):
+            if self._in_block(k, count) != before:
+                self._show_block(self.plotter.actors[f"beads{k}"], k, count, self._faces[k])
+                self._shown[k] = self._in_block(k, count)
 
     def _status(self, move: int) -> str:
         row = int(self.rows[move - 1])
