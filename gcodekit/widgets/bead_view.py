@@ -116,7 +116,11 @@ class BeadView(TrameView):
         plotter.set_background(BACKGROUND)
         live = plotter is self.plotter
         count = int(self._counts[self.move - 1])
-        self._faces: list[np.ndarray] = []
+        if live:
+            # each block's mesh (the actor's input: its mapper's own dataset may be a pipeline's copy) and
+            # whole face list, which steps slice
+            self._meshes: list = []
+            self._faces: list[np.ndarray] = []
         for k in range(len(self._bounds) - 1):
             mesh = self._block_mesh(k)
             if self.categories is not None:
@@ -130,25 +134,27 @@ class BeadView(TrameView):
                                                   position_y=0.1, height=0.8, width=0.04))
             actor = plotter.add_mesh(mesh, scalars="color", name=f"beads{k}", **style)
             if live:
+                self._meshes.append(mesh)
                 self._faces.append(mesh.faces.copy())
-            self._show_block(actor, k, count, mesh.faces.copy())
+            self._show_block(actor, mesh, k, count, mesh.faces.copy())
         if live:
             self._shown = [self._in_block(k, count) for k in range(len(self._bounds) - 1)]
         # the whole part framed, whatever move is shown; shaded smoothly by the tubes' own normals
         plotter.view_isometric()
         lo, hi = self.tubes.points.min(axis=0), self.tubes.points.max(axis=0)
         plotter.reset_camera(bounds=[lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]])
+        plotter.camera_set = True  # PyVista would otherwise fit the first picture to the beads shown
 
     def _in_block(self, k: int, count: int) -> int:
         """How many of block ``k``'s triangles the first ``count`` triangles take."""
         return int(np.clip(count - self._bounds[k], 0, self._bounds[k + 1] - self._bounds[k]))
 
-    def _show_block(self, actor, k: int, count: int, faces: np.ndarray) -> None:
+    def _show_block(self, actor, mesh, k: int, count: int, faces: np.ndarray) -> None:
         """Show block ``k``'s share of the first ``count`` triangles (``faces``: all of the block's)."""
         shown = self._in_block(k, count)
         actor.visibility = shown > 0
-        if shown and actor.mapper.dataset.n_cells != shown:
-            actor.mapper.dataset.faces = faces[:4 * shown]
+        if shown and mesh.n_cells != shown:
+            mesh.faces = faces[:4 * shown]
 
     def _update(self, move: int) -> None:
         # only the blocks whose share changes are touched: those wholly before or after the move stay as they
@@ -156,7 +162,7 @@ class BeadView(TrameView):
         count = int(self._counts[move - 1])
         for k, before in enumerate(self._shown):
             if self._in_block(k, count) != before:
-                self._show_block(self.plotter.actors[f"beads{k}"], k, count, self._faces[k])
+                self._show_block(self.plotter.actors[f"beads{k}"], self._meshes[k], k, count, self._faces[k])
                 self._shown[k] = self._in_block(k, count)
 
     def _status(self, move: int) -> str:

@@ -186,5 +186,5 @@ class TrameView:
         buffer = io.BytesIO()
         Image.fromarray(np.asarray(self.screenshot(), np.uint8)).save(buffer, format="PNG")
         bundle["image/png"] = base64.b64encode(buffer.getvalue()).decode("ascii")
-        bundle.setdefault("text/plain", repr(self))
+        bundle["text/plain"] = repr(self)
         return bundle
