@@ -121,6 +121,7 @@ def test_beads_show_turn_and_follow_the_slider(lab):
     area.locator(f".gcodekit-bead-status[data-move='{moves - 1}']").wait_for(state="attached", timeout=60_000)
     step_s = time.perf_counter() - start
     text = (f"Home (all {moves} moves to move 1): status {status_s:.2f} s, new picture {home_s:.2f} s; "
-            f"End (back to all): status {end_status_s:.2f} s, new picture {end_s:.2f} s; one step back: status {step_s:.2f} s\n")
+            f"End (back to all): status {end_status_s:.2f} s, new picture {end_s:.2f} s; "
+            f"one step back: status {step_s:.2f} s\n")
     (root / "bead_view_timing.txt").write_text(text)
     print(text)
