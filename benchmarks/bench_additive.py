@@ -99,7 +99,8 @@ def main(argv: list[str] | None = None) -> int:
     for name, seconds, peak, added in rows:
         print(f"{name:22}{seconds:9.2f}{peak:10.1f}{added:10.1f}")
     if args.json:
-        Path(args.json).write_text(json.dumps({"runs": runs, "best": best, "worst": worst}, indent=2))
+        Path(args.json).write_text(json.dumps({"file": args.file.name, "runs": runs, "best": best, "worst": worst},
+                                              indent=2))
     return 0
 
 

@@ -37,6 +37,7 @@ from pathlib import Path
 
 CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "fff"
 CYLINDER = CORPUS / "cylinder_marlin2.gcode"
+QUICK = CORPUS / "cube20_marlin2.gcode"
 PLATE = CORPUS / "plate150_marlin2.gcode.gz"
 MIN_SPEEDUP = 50.0
 MAX_MEMORY_SHARE = 0.1
@@ -97,9 +98,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=3, help="gcodekit runs per figure (default: 3)")
     parser.add_argument("--peer-repeat", type=int, default=1, help="pyGCodeDecode runs (default: 1, ~1 min each)")
     parser.add_argument("--skip-plate", action="store_true", help="skip the plate150 planning-overhead figure")
+    parser.add_argument("--quick", action="store_true",
+                        help=f"smoke run: {QUICK.name}, one run each, no plate150 (the targets bind on the cylinder)")
     parser.add_argument("--json", metavar="OUT", help="also write the figures as JSON")
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    program = QUICK if args.quick else CYLINDER
+    if args.quick:
+        args.repeat, args.peer_repeat, args.skip_plate = 1, 1, True
     if args.child:
         print(json.dumps(child(*args.child)))
         return 0
@@ -110,19 +116,20 @@ def main(argv: list[str] | None = None) -> int:
     ours, peer = [], []
     for i in range(max(args.repeat, args.peer_repeat)):
         if i < args.peer_repeat:
-            peer.append(run_child("pygcodedecode", CYLINDER, args.machine))
+            peer.append(run_child("pygcodedecode", program, args.machine))
             print(f"pyGCodeDecode run {i + 1}: {peer[-1]['seconds']:.2f} s", flush=True)
         if i < args.repeat:
-            ours.append(run_child("gcodekit", CYLINDER, args.machine))
+            ours.append(run_child("gcodekit", program, args.machine))
             print(f"gcodekit run {i + 1}: {ours[-1]['seconds']:.2f} s", flush=True)
     best, best_peer = min(ours, key=lambda r: r["seconds"]), min(peer, key=lambda r: r["seconds"])
     speedup = best_peer["seconds"] / best["seconds"]
     worst, worst_peer = max(ours, key=_used_mb), max(peer, key=_used_mb)
     mem_share = _used_mb(worst) / _used_mb(worst_peer)
     total_share = worst["peak_mb"] / worst_peer["peak_mb"]
-    figures = {"file": CYLINDER.name, "machine": args.machine, "gcodekit": best, "pygcodedecode": best_peer,
+    figures = {"file": program.name, "acceptance": program == CYLINDER, "machine": args.machine,
+               "gcodekit": best, "pygcodedecode": best_peer,
                "speedup": speedup, "memory_share": mem_share, "total_memory_share": total_share}
-    print(f"\n{CYLINDER.name}  (gcodekit machine {args.machine}; pyGCodeDecode preset prusa_mini)")
+    print(f"\n{program.name}  (gcodekit machine {args.machine}; pyGCodeDecode preset prusa_mini)")
     print(f"{'':14}{'seconds':>10}{'peak MB':>10}{'after import':>14}{'used MB':>10}{'print time s':>14}")
     for name, r, m in (("gcodekit", best, worst), ("pyGCodeDecode", best_peer, worst_peer)):
         print(f"{name:14}{r['seconds']:10.2f}{m['peak_mb']:10.1f}{m['base_mb']:14.1f}{_used_mb(m):10.1f}"
@@ -143,7 +150,7 @@ def main(argv: list[str] | None = None) -> int:
         ok &= share <= MAX_PLAN_SHARE
     if args.json:
         Path(args.json).write_text(json.dumps(figures, indent=2))
-    return 0 if ok else 1
+    return 0 if ok or program != CYLINDER else 1
 
 
 if __name__ == "__main__":

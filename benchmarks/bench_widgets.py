@@ -31,6 +31,7 @@ Examples
 from __future__ import annotations
 
 import argparse
+import json
 import shutil
 import statistics
 import sys
@@ -122,12 +123,17 @@ def main(argv=None) -> int:
     parser.add_argument("--files", nargs="+", type=Path, default=FILES)
     parser.add_argument("--steps", type=int, default=30)
     parser.add_argument("--pause", type=int, default=400, help="ms between key presses (default: 400)")
+    parser.add_argument("--quick", action="store_true", help="smoke run: cube20 only, 5 steps each way")
+    parser.add_argument("--json", metavar="OUT", help="also write the medians as JSON")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.files, args.steps = [FILES[1]], 5
     t0 = time.perf_counter()
     import gcodekit  # noqa: F401
 
     print(f"import gcodekit: {(time.perf_counter() - t0) * 1000:.0f} ms")
     failed = False
+    figures = []
     for program in args.files:
         r = browser_steps(program, args.steps, args.pause)
         png = peer_png(program, args.steps)
@@ -144,8 +150,13 @@ def main(argv=None) -> int:
         if r["errors"]:
             print(f"  browser console errors: {r['errors']}")
         ok = med["shown"] <= LIMIT_MS and med["plot"] <= LIMIT_MS
+        figures.append({"file": program.name, "steps": len(r["drawn"]), "segments": r["segments"],
+                        **{f"{k}_ms": med[k] for k in med}, "peer_png_ms": statistics.median(png),
+                        "limit_ms": LIMIT_MS, "pass": ok})
         failed |= not ok
         print(f"  {'PASS' if ok else 'FAIL'}: medians within {LIMIT_MS:.0f} ms")
+    if args.json:
+        Path(args.json).write_text(json.dumps(figures, indent=2) + "\n")
     return 1 if failed else 0
 
 

@@ -10,8 +10,6 @@ no-op.
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import functools
 import sys
 
@@ -20,11 +18,18 @@ import sys
 def _malloc_trim():
     if not sys.platform.startswith("linux"):
         return None
+    import ctypes  # imported here, and glibc tried by name: ctypes.util.find_library starts ldconfig
+
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        return libc.malloc_trim
-    except (OSError, AttributeError):  # not glibc (musl has no malloc_trim)
-        return None
+        libc = ctypes.CDLL("libc.so.6")
+    except OSError:
+        import ctypes.util
+
+        try:
+            libc = ctypes.CDLL(ctypes.util.find_library("c"))
+        except OSError:
+            return None
+    return getattr(libc, "malloc_trim", None)  # not glibc (musl has no malloc_trim)
 
 
 def release_freed_memory() -> bool:

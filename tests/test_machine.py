@@ -600,3 +600,11 @@ def test_standalone_canon_stores_g28_home_with_the_held_tool_offset():
     text = "G20\nG43.1 X0.06487 Z-0.30651\nG21\nG28.1\nG28\nM2\n"
     op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False, standalone_canon=True)
     np.testing.assert_allclose(op.motions()[["x", "y", "z"]].to_numpy(), np.zeros((2, 3)), atol=1e-9)
+
+
+@pytest.mark.parametrize("machine, names_linuxcnc", [("linuxcnc", True), ("fanuc", False)])
+def test_the_no_tool_table_warning_names_linuxcnc_only_on_linuxcnc(machine, names_linuxcnc):
+    """A Fanuc control takes lengths from its own offset registers: its warning must not speak of LinuxCNC."""
+    op = gcodekit.gcode_to_operation("T1 M6\nG43 H1\nG1 X1 F100\nM30\n", machine, plan=False)
+    (warning,) = [d for d in op.diagnostics.items if "no tool table" in d.message]
+    assert ("LinuxCNC" in warning.message) == names_linuxcnc

@@ -5,7 +5,8 @@ the pictures (matplotlib, off-screen), :mod:`.html` renders the pages
 (Jinja2), :mod:`.pdf` prints them with headless Chromium, :mod:`.batch` runs
 many programs on worker processes or a Dask cluster and :mod:`.notebook`
 writes the same report as an executed notebook.  Nothing heavy is imported
-until a report is made.
+until a report is made (the batch module
+included).
 
 Examples
 --------
@@ -17,6 +18,20 @@ Examples
 
 from __future__ import annotations
 
-from .batch import ReportOptions, report_program, write_reports
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .batch import ReportOptions, report_program, write_reports
+
+
+def __getattr__(name: str) -> Any:
+    """The batch functions, loaded on first use: ``gcodekit info`` formats durations with
+    :mod:`.html` and needs no worker pools."""
+    if name in __all__:
+        from . import batch
+
+        return getattr(batch, name)
+    raise AttributeError(f"module 'gcodekit.report' has no attribute {name!r}")
+
 
 __all__ = ["ReportOptions", "report_program", "write_reports"]

@@ -9,7 +9,8 @@ program at the end.
 On this machine's processes the PDFs are printed by the calling process, as
 pages arrive, with one Chromium for the whole batch: a browser costs about
 2 CPU-seconds to start and its first page, which a second worker with its
-own browser took from the other worker's core.  On a Dask cluster each
+own browser took from the other worker's core.  That browser is started
+when the batch starts, so it boots beside the first program's work.  On a Dask cluster each
 worker prints its own pages (the client may not have Chromium or the cores).
 """
 
@@ -19,12 +20,12 @@ import os
 import re
 import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence
 
-from ..errors import GcodeError
+from ..errors import GcodeError, MissingDependencyError
 from ..limits import MAX_ITERATIONS, MAX_MOTIONS
 
 if TYPE_CHECKING:
@@ -197,6 +198,11 @@ def write_reports(paths: Sequence[str | os.PathLike], out_dir: str | os.PathLike
     # absolute paths: a Dask worker may run in another directory (it must see the same file system)
     print_here = options.pdf and not dask  # one Chromium for the batch: see the module's docstring
     job_options = replace(options, pdf=False) if print_here else options
+    if print_here:
+        from .pdf import start_browser
+
+        with suppress(MissingDependencyError, OSError):  # without Chromium, each PDF says why in its row
+            start_browser()
     jobs = [(os.path.abspath(p), os.path.abspath(out), n, job_options) for p, n in zip(paths, names)]
     jobs.sort(key=lambda j: os.path.getsize(j[0]) if os.path.isfile(j[0]) else 0, reverse=True)
     rows: dict[str, dict[str, Any]] = {}

@@ -5,10 +5,10 @@ all and returns them as ``data:`` URIs so a page embeds them and works
 offline.  The toolpath pictures draw the one :class:`~gcodekit.view.Toolpath`
 with the one :class:`~gcodekit.view.Coloring` through
 :func:`gcodekit.visualize.draw_toolpath`, as the notebook viewer and the
-PyVista pictures do.  Large programs are thinned before drawing (every k-th
-layer in 3D, every k-th segment elsewhere, binned speeds) so a 150 k-line
-print draws in about a second: a picture 800 pixels wide cannot show more
-anyway.
+PyVista pictures do, every segment of the program but only those the
+picture's pixels show (:mod:`gcodekit.view.lod`), joined into polylines: a
+3 M-line print draws in seconds and looks as its full drawing does.  The
+speed plot bins the program's speeds.
 """
 
 from __future__ import annotations
@@ -20,16 +20,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..view import WORK, Coloring, Toolpath, ToolpathError, coloring, default_coloring
+from ..view import TRAVEL_COLOR, WORK, Coloring, Toolpath, ToolpathError, coloring, default_coloring
+from ..view.coloring import hex_rgb
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from ..model.operation import Operation
 
-#: Segments drawn in the 3D view and the top view (beyond this they only add ink).
-MAX_3D_SEGMENTS = 25_000
-MAX_2D_SEGMENTS = 60_000
 THUMBNAILS = 12
 #: The pictures of a report page.
 FIGURES = ("iso", "top", "layer_times", "thumbnails", "velocity", "breakdown", "part")
@@ -57,14 +55,13 @@ class Drawing:
 
     @property
     def start(self) -> np.ndarray:
+        """First end of each segment drawn, (n, 3) mm."""
         return self.path.start[self.segments]
 
     @property
     def end(self) -> np.ndarray:
+        """Second end of each segment drawn, (n, 3) mm."""
         return self.path.end[self.segments]
-
-    def take(self, keep: np.ndarray) -> "Drawing":
-        return Drawing(self.path, self.color, self.segments[keep])
 
 
 def toolpath_drawing(op: "Operation", color_by: str | None = None) -> Drawing | None:
@@ -77,26 +74,6 @@ def toolpath_drawing(op: "Operation", color_by: str | None = None) -> Drawing | 
     color = coloring(path, color_by or default_coloring(op))
     keep = path.kind == WORK if op.process == "additive" else np.ones(path.n_segments, bool)
     return Drawing(path, color, np.flatnonzero(keep))
-
-
-def _thin(drawing: Drawing, limit: int, by_layer: bool) -> Drawing:
-    """At most about ``limit`` segments: every k-th layer when layered, else every k-th segment."""
-    n = drawing.segments.size
-    if n <= limit:
-        return drawing
-    layer = drawing.layer
-    if by_layer and (layer >= 0).any():
-        ids = np.unique(layer[layer >= 0])
-        step = int(np.ceil(n / limit))
-        chosen = ids[::step]
-        if chosen[-1] != ids[-1]:
-            chosen = np.r_[chosen, ids[-1]]  # keep the top layer: it is what the part looks like
-        kept = drawing.take(np.isin(layer, chosen))
-        if kept.segments.size <= 2 * limit:
-            return kept
-        drawing = kept
-        n = drawing.segments.size
-    return drawing.take(np.arange(0, n, int(np.ceil(n / limit))))
 
 
 def _figure(height: float, **margins: float) -> "Figure":
@@ -116,13 +93,12 @@ def toolpath_iso(drawing: Drawing) -> "Figure":
     """The toolpath seen by the ``iso`` camera (orthographic, from +X, -Y, +Z), as the viewer shows it."""
     from ..visualize import add_legend, draw_toolpath, fitted_camera
 
-    drawing = _thin(drawing, MAX_3D_SEGMENTS, by_layer=True)
     fig = _figure(5.0)
     ax = fig.add_axes((0.0, 0.0, 0.78, 1.0))
     ax.set_axis_off()
     camera = fitted_camera("iso", drawing.path, 0.78 * WIDTH_IN / 5.0)
     vmin, vmax = draw_toolpath(ax, drawing.path, drawing.color, camera, drawing.segments,
-                               work_width=0.6, travel_width=0.5)
+                               work_width=0.6, travel_width=0.5, lod=True)
     add_legend(fig, drawing.color, drawing.path, drawing.segments, vmin, vmax)
     return fig
 
@@ -131,12 +107,11 @@ def toolpath_top(drawing: Drawing) -> "Figure":
     """Top view (XY) of the whole toolpath, axes in machine millimetres."""
     from ..visualize import add_legend, draw_toolpath, fitted_camera
 
-    drawing = _thin(drawing, MAX_2D_SEGMENTS, by_layer=False)
     fig = _figure(4.6)
     ax = fig.add_axes((0.09, 0.1, 0.69, 0.83))
     camera = fitted_camera("top", drawing.path, 0.69 * WIDTH_IN / (0.83 * 4.6))
     vmin, vmax = draw_toolpath(ax, drawing.path, drawing.color, camera, drawing.segments,
-                               work_width=0.5, travel_width=0.5, absolute=True)
+                               work_width=0.5, travel_width=0.5, absolute=True, lod=True)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("X, mm")
     ax.set_ylabel("Y, mm")
@@ -149,6 +124,8 @@ def layer_thumbnails(drawing: Drawing, count: int = THUMBNAILS) -> "Figure | Non
     """Small XY views of ``count`` layers spread over the height, on the part's extents."""
     from matplotlib.collections import LineCollection
 
+    from ..view.lod import polylines
+
     layer = drawing.layer
     ids = np.unique(layer[layer >= 0])
     if ids.size == 0:
@@ -157,17 +134,21 @@ def layer_thumbnails(drawing: Drawing, count: int = THUMBNAILS) -> "Figure | Non
     cols = 6
     rows = int(np.ceil(chosen.size / cols))
     fig = _figure(1.45 * rows + 0.2, left=0.01, right=0.99, bottom=0.02, top=0.92, wspace=0.08, hspace=0.25)
-    colours, _, _ = drawing.color.segment_rgb(drawing.path, drawing.segments)
-    start, end = drawing.start, drawing.end
     layered = layer >= 0  # the extents of the layers, not of a purge line drawn before them
-    lo, hi = start[layered, :2].min(axis=0), start[layered, :2].max(axis=0)
+    lo = drawing.path.start[drawing.segments[layered], :2].min(axis=0)
+    hi = drawing.path.start[drawing.segments[layered], :2].max(axis=0)
     pad = 0.03 * max(float((hi - lo).max()), 1.0)
     lo, hi = lo - pad, hi + pad
+    # colours of the chosen layers only, on the colour scale of the whole drawing
+    shown = np.flatnonzero(np.isin(layer, chosen))
+    colours = _colours(drawing, shown)
+    picked = drawing.segments[shown]
+    start, end, layer = drawing.path.start[picked, :2], drawing.path.end[picked, :2], layer[shown]
     for k, one in enumerate(chosen):
         ax = fig.add_subplot(rows, cols, k + 1)
         sel = layer == one
-        ax.add_collection(LineCollection(np.stack([start[sel, :2], end[sel, :2]], axis=1),
-                                         colors=colours[sel], linewidths=0.4))
+        runs = polylines(start[sel], end[sel], colours[sel])  # one path per run of joined moves
+        ax.add_collection(LineCollection(runs.runs(), colors=colours[sel][runs.first], linewidths=0.4))
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
         ax.set_aspect("equal")
@@ -175,6 +156,17 @@ def layer_thumbnails(drawing: Drawing, count: int = THUMBNAILS) -> "Figure | Non
         ax.set_yticks([])
         ax.set_title(f"layer {int(one)}", fontsize=7)
     return fig
+
+
+def _colours(drawing: Drawing, shown: np.ndarray) -> np.ndarray:
+    """RGB of the drawing's segments ``shown`` (indices into it), on the colour scale of all its segments."""
+    path, color, segments = drawing.path, drawing.color, drawing.segments
+    work = path.kind[segments] == WORK
+    vmin, vmax = color.value_range(segments[work])
+    rgb = np.tile(hex_rgb(TRAVEL_COLOR), (shown.size, 1))
+    shown_work = work[shown]
+    rgb[shown_work] = color.rgb(color.values[segments[shown][shown_work]], vmin, vmax)
+    return rgb
 
 
 def layer_times(rows: list[dict[str, Any]], slicer_rows: list[dict[str, Any]] = ()) -> "Figure | None":

@@ -59,8 +59,12 @@ def waypoint_scalars(op: "Operation", by: str) -> tuple[np.ndarray, list[str] | 
     """
     w = op.waypoints
     if by == "feature":
-        names, codes = np.unique(op.features.astype(str), return_inverse=True)
-        return codes.astype(np.int32), [n or NO_FEATURE for n in names.tolist()]
+        # a few names over millions of waypoints: look each up (sorting millions of strings took seconds)
+        labels = op.features.tolist()
+        names = sorted(set(labels))
+        index = {name: k for k, name in enumerate(names)}
+        codes = np.fromiter(map(index.__getitem__, labels), np.int32, count=len(labels))
+        return codes, [n or NO_FEATURE for n in names]
     if by == "speed":
         d, t = np.asarray(w["distance"], float), np.nan_to_num(np.asarray(w["time"], float))
         return np.divide(d, t, out=np.zeros_like(d), where=t > 0), None

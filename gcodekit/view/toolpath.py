@@ -171,11 +171,18 @@ class Toolpath:
         Travel to a parking or home position would otherwise shrink the part to a dot.
         """
         if keep is None:
-            keep = self.kind == WORK if (self.kind == WORK).any() else slice(None)
+            lo, hi = self._work_bounds
+            return lo.copy(), hi.copy()
         both = np.vstack([self.start[keep], self.end[keep]])
         if both.size == 0:
             return np.zeros(3), np.zeros(3)
         return both.min(axis=0), both.max(axis=0)
+
+    @cached_property
+    def _work_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`bounds` of the work, once: every picture and camera asks (a copy of 3 M segments each time)."""
+        work = self.kind == WORK
+        return self.bounds(work if work.any() else slice(None))
 
     def frame(self) -> tuple[np.ndarray, float]:
         """Centre of :meth:`bounds` and the radius of the sphere around them, mm."""

@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Callable, Iterable, Sequence
+from typing import TYPE_CHECKING, Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -78,8 +78,10 @@ def check_program(program: str | None, requirements: Sequence[Requirement], mach
 
     if program is None or not str(program).strip():
         return ProgramCheck(None, "Not answered yet: write your program in the cell above and run both cells again.")
+    # a program written as """ + newline + lines: its first G-code line is line 1, as the student counts
+    program = str(program)[1:] if str(program).startswith("\n") else str(program)
     try:
-        op = gcode_to_operation(str(program), machine, **options)
+        op = gcode_to_operation(program, machine, **options)
     except Exception as exc:  # a program gcodekit refuses: say why, with its line
         return ProgramCheck(False, f"Not yet: gcodekit cannot run your program: {exc}")
     errors = [str(d).replace("<string>:", "line ", 1) for d in op.diagnostics.errors]
@@ -88,7 +90,7 @@ def check_program(program: str | None, requirements: Sequence[Requirement], mach
                             + "\n- ".join(errors[:3]), op, ["runs without errors"])
     failed = []
     for requirement in requirements:
-        problem = requirement.test(op, str(program))
+        problem = requirement.test(op, program)
         if problem:
             failed.append(f"{requirement.text}: {problem}")
     if not failed:
@@ -193,7 +195,7 @@ def passes_through(points: Sequence[Sequence[float]], *, cutting: bool = True, t
         if not missed:
             return None
         if says is not None:
-            return f"it misses {len(missed)} of the {len(points)} places"
+            return "it never gets there" if len(points) == 1 else f"it misses {len(missed)} of the {len(points)} places"
         return ("the cut never reaches " if cutting else "the tool never reaches ") + ", ".join(_xyz(p) for p in missed)
 
     text = ("cuts through " if cutting else "goes through ") + ", ".join(_xyz(p) for p in points)
@@ -501,6 +503,147 @@ def layer_time_at_least(seconds: float) -> Requirement:
         return f"layer {short.index[0]} takes {float(short.iloc[0]):.2f} s" if len(short) else None
 
     return Requirement(f"every layer takes at least {seconds:g} s", test)
+
+
+#: The heater commands of the command table: the heater each sets, and whether it waits.
+_HEATER_COMMANDS = {"set_hotend_temp": ("nozzle", False), "wait_hotend_temp": ("nozzle", True),
+                    "set_bed_temp": ("bed", False), "wait_bed_temp": ("bed", True)}
+
+
+def heater_waits(op: "Operation", rates: Mapping[str, float], room: float = 25.0) -> list[tuple[int, str, float]]:
+    """How long each M109/M190 of the program waits, with heaters that change temperature at a constant rate.
+
+    A teaching model, not a thermal one: each heater (``"nozzle"``, ``"bed"``) starts at ``room`` °C and moves
+    towards the target its last M104/M109 (M140/M190) set at ``rates[heater]`` °C/s, from the moment that line
+    runs (the planned time of the moves before it plus the waits so far). A wait (M109/M190 with S) lasts until
+    the heater has reached its target from below, as Marlin's ``M109 S`` does; a target below the heater's
+    temperature is not waited for.
+
+    Parameters
+    ----------
+    op : Operation
+    rates : mapping of str to float
+        °C/s per heater (``{"nozzle": 2.5, "bed": 0.5}``); a heater left out is not modelled.
+    room : float, default: 25.0
+        Every heater's temperature at the start, °C.
+
+    Returns
+    -------
+    list of (line, heater, seconds)
+        One entry per wait, in program order.
+
+    Examples
+    --------
+    Waiting for the bed before the nozzle's target is even set: 35 °C at 0.5 °C/s, then 185 °C at 2.5 °C/s.
+
+    >>> from gcodekit.pipeline import gcode_to_operation
+    >>> heater_waits(gcode_to_operation("M190 S60\\nM109 S210\\nG1 X10 F600\\n", "marlin"), {"nozzle": 2.5, "bed": 0.5})
+    [(1, 'bed', 70.0), (2, 'nozzle', 74.0)]
+    """
+    w = op.waypoints
+    command = np.asarray(w["command"])
+    clock = np.cumsum(np.nan_to_num(np.asarray(w["time"], float)))
+    at = {int(c): float(t) for c, t in zip(command, clock)}  # the last row of each command
+    temp = {heater: float(room) for heater in rates}
+    target = dict(temp)
+    since = {heater: 0.0 for heater in rates}
+    waited, waits = 0.0, []
+
+    def now_temp(heater: str, t: float) -> float:
+        step = rates[heater] * (t - since[heater])
+        start = temp[heater]
+        return min(target[heater], start + step) if target[heater] >= start else max(target[heater], start - step)
+
+    for index, cmd in enumerate(op.commands):
+        kind = _HEATER_COMMANDS.get(getattr(cmd, "name", None))
+        if kind is None or kind[0] not in rates:
+            continue
+        heater, wait = kind
+        t = at.get(index, 0.0) + waited
+        value = cmd.params.get("S", cmd.params.get("R"))
+        temp[heater], since[heater] = now_temp(heater, t), t
+        if value is not None:
+            target[heater] = float(value)
+        if wait:
+            seconds = max(0.0, (target[heater] - temp[heater]) / rates[heater])
+            waits.append((int(cmd.line), heater, seconds))
+            waited += seconds
+    return waits
+
+
+def waits_for_heaters(bed: float, nozzle: float) -> Requirement:
+    """Before the first printed move the program waits for the bed (M190) to reach ``bed`` °C and then for the
+    nozzle (M109) to reach ``nozzle`` °C."""
+
+    def test(op, source):
+        printing = np.flatnonzero(np.asarray(op.depositing))
+        if printing.size == 0:
+            return "the program prints nothing"
+        first = int(np.asarray(op.waypoints["command"])[printing[0]])
+        waits = {"wait_bed_temp": None, "wait_hotend_temp": None}
+        wanted = {"wait_bed_temp": bed, "wait_hotend_temp": nozzle}
+        for index, cmd in enumerate(op.commands[:first]):
+            name = getattr(cmd, "name", None)
+            if name in waits and waits[name] is None and cmd.params.get("S") is not None \
+                    and abs(float(cmd.params["S"]) - wanted[name]) < 0.5:
+                waits[name] = (index, int(cmd.line))
+        line = int(op.commands[first].line)
+        problems = []
+        if waits["wait_bed_temp"] is None:
+            problems.append(f"nothing waits for the bed to reach {bed:g} °C before the first printed line "
+                            f"(line {line})")
+        if waits["wait_hotend_temp"] is None:
+            problems.append(f"nothing waits for the nozzle to reach {nozzle:g} °C before the first printed line "
+                            f"(line {line})")
+        if not problems and waits["wait_hotend_temp"][0] < waits["wait_bed_temp"][0]:
+            problems.append(f"line {waits['wait_hotend_temp'][1]} waits for the nozzle before line "
+                            f"{waits['wait_bed_temp'][1]} waits for the bed: the hot nozzle oozes while the bed heats")
+        return "; ".join(problems) or None
+
+    return Requirement(f"waits for the bed ({bed:g} °C), then the nozzle ({nozzle:g} °C), before printing", test)
+
+
+def heats_within(seconds: float, rates: Mapping[str, float], room: float = 25.0) -> Requirement:
+    """The program's waits for its heaters (:func:`heater_waits`) add up to less than ``seconds``."""
+
+    def test(op, source):
+        waits = heater_waits(op, rates, room)
+        total = sum(s for _, _, s in waits)
+        if total < seconds:
+            return None
+        return f"it waits {total:.0f} s for its heaters (" + ", ".join(f"line {line}: {s:.0f} s" for line, _, s in waits
+                                                                      if s > 0) + ")"
+
+    return Requirement(f"heating done in under {seconds:g} s", test)
+
+
+def fan_from_layer(layer: int, speed: float = 255) -> Requirement:
+    """Printed moves on layers below ``layer`` run with the part-cooling fan off, the others at ``speed`` (M106 S,
+    0-255; M106 without S is full speed, M107 off)."""
+
+    def test(op, source):
+        fan = np.zeros(len(op.commands) + 1)
+        value = 0.0
+        for index, cmd in enumerate(op.commands):
+            name = getattr(cmd, "name", None)
+            if name == "fan_on":
+                value = float(cmd.params.get("S", 255.0))
+            elif name == "fan_off":
+                value = 0.0
+            fan[index] = value
+        printing = np.flatnonzero(np.asarray(op.depositing))
+        if printing.size == 0:
+            return "the program prints nothing"
+        layers = np.asarray(op.layers)[printing]
+        at = fan[np.asarray(op.waypoints["command"])[printing]]
+        wrong = np.flatnonzero(np.abs(at - np.where(layers < layer, 0.0, float(speed))) > 0.5)
+        if wrong.size == 0:
+            return None
+        k = wrong[0]
+        state = "off" if at[k] == 0 else f"at S{at[k]:g}"
+        return f"layer {int(layers[k])} prints (line {_line(op, printing[k])}) with the fan {state}"
+
+    return Requirement(f"the part fan off below layer {layer} and at S{speed:g} from it on", test)
 
 
 def _swept_angle(op: "Operation", rows: np.ndarray, center: Sequence[float]) -> float:

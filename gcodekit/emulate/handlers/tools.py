@@ -29,8 +29,10 @@ def check_tool(ctx: Context, number: int, line: int) -> None:
     if number and config.tool_table and number not in ctx.tools:
         ctx.error(line, f"Requested tool {number} not found in the tool table")
     elif number and not config.tool_table and config.process != "additive" and _reads_tool_lengths(config.flavor):
+        consequence = ("LinuxCNC refuses a tool its table lacks" if config.flavor == "rs274ngc"
+                       else "the control's own offsets are not known here")
         ctx.warn_once("no tool table", line, f"no tool table: tool {number} (and every other) is taken to have no "
-                      "length or diameter; LinuxCNC refuses a tool its table lacks (give the machine a tool_table)")
+                      f"length or diameter; {consequence} (give the machine a tool_table)")
 
 
 def _reads_tool_lengths(flavor: str) -> bool:
