@@ -8,6 +8,7 @@ SwiftShader for WebGL.  Also used by ``benchmarks/bench_widgets.py``.
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import shutil
@@ -18,6 +19,8 @@ import time
 import urllib.request
 from contextlib import contextmanager
 from pathlib import Path
+
+import numpy as np
 
 #: WebGL through SwiftShader (no GPU here) with the page composited in software, as Chromium does by
 #: itself on a machine without a GPU: compositing whole pages through SwiftShader cost 150-400 ms a
@@ -129,3 +132,53 @@ def delete_sessions(url: str) -> None:
     for s in sessions:
         request = urllib.request.Request(f"{url}/api/sessions/{s['id']}", method="DELETE")
         urllib.request.urlopen(request).close()
+
+
+def shot(locator):
+    """A screenshot of ``locator`` as an (height, width, 3) int array."""
+    from PIL import Image
+
+    return np.asarray(Image.open(io.BytesIO(locator.screenshot())).convert("RGB"), dtype=int)
+
+
+def wait_for_picture(frame, previous, timeout_s=120.0):
+    """Poll the view until its picture differs from ``previous``; the new picture and the seconds waited."""
+    start = time.perf_counter()
+    while time.perf_counter() - start < timeout_s:
+        now = shot(frame)
+        if np.mean(np.any(now != previous, axis=2)) > 0.002:
+            waited = time.perf_counter() - start
+            time.sleep(0.5)  # then let it settle
+            return shot(frame), waited
+        time.sleep(0.05)
+    raise AssertionError("the view's picture did not change")
+
+
+def settled(frame, timeout_s=30.0):
+    """The view's picture once two screenshots half a second apart agree (it has finished drawing)."""
+    before = shot(frame)
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        time.sleep(0.5)
+        now = shot(frame)
+        if np.array_equal(now, before):
+            return now
+        before = now
+    return before
+
+
+def drag_turns(page, frame, before, attempts=3):
+    """Drag across the view's middle until its picture changes (a view still loading may miss the first drag)."""
+    box = frame.bounding_box()
+    cx, cy = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    for attempt in range(attempts):
+        page.mouse.move(cx, cy)
+        page.mouse.down()
+        page.mouse.move(cx + 160, cy + 40, steps=12)
+        page.mouse.up()
+        try:
+            return wait_for_picture(frame, before, timeout_s=90)[0]
+        except AssertionError:
+            if attempt == attempts - 1:
+                raise
+    raise AssertionError("unreachable")
