@@ -25,7 +25,7 @@ from .model.derived import depositing, depositing_of, features, layers, row_labe
 from .model.statistics import operation_statistics
 from .parse.table import NAME_ID as NAME_ID_LOOKUP
 
-__all__ = ["time_by", "slicer_layer_times", "velocity_profile", "part_name", "tool_vectors", "ded_moves", "depositing", "depositing_of",
+__all__ = ["time_by", "slicer_layer_times", "velocity_profile", "velocity_corners", "part_name", "tool_vectors", "ded_moves", "depositing", "depositing_of",
            "features", "layers", "screw_extruder", "waypoint_rows", "operation_statistics", "event_series",
            "gcode_dataframe_to_event_series"]
 
@@ -113,15 +113,21 @@ def slicer_layer_times(op: "Operation", mode: str = "normal") -> "pd.DataFrame":
 
 
 def velocity_profile(op: "Operation") -> "pd.DataFrame":
+    """Speed over time, for plots: :func:`velocity_corners` as a DataFrame."""
+    import pandas as pd
+
+    return pd.DataFrame(velocity_corners(op))
+
+
+def velocity_corners(op: "Operation") -> dict[str, np.ndarray]:
     """Speed over time, for plots: planned (trapezoids) and commanded.
 
     One row per corner of each move's velocity trapezoid: ``time`` (s),
     ``distance`` (mm travelled so far), ``planned`` and ``commanded`` speed
     (mm/s), and the source ``line``.  Without a planner the planned speed is
-    the commanded one, held for each move.
+    the commanded one, held for each move.  Columns as NumPy arrays (a
+    DataFrame of a 3 M-line print's 12 M corners costs seconds to assemble).
     """
-    import pandas as pd
-
     plan = op.plan
     if plan is None:
         w = op.waypoints
@@ -132,14 +138,14 @@ def velocity_profile(op: "Operation") -> "pd.DataFrame":
         d_end = np.cumsum(np.asarray(w["distance"], float)[moved])
         d_start = d_end - np.asarray(w["distance"], float)[moved]
         line = op.table.line[waypoint_rows(op)[moved]]
-        return pd.DataFrame({
+        return {
             "time": np.column_stack([t_end - dur, t_end]).ravel(),
             "distance": np.column_stack([d_start, d_end]).ravel(),
             "planned": np.repeat(speed, 2), "commanded": np.repeat(speed, 2), "line": np.repeat(line, 2),
-        })
+        }
     moves, r = plan
     if len(moves) == 0:  # nothing moved: no trapezoids to lay out
-        return pd.DataFrame({c: np.zeros(0) for c in ("time", "distance", "planned", "commanded", "line")})
+        return {c: np.zeros(0) for c in ("time", "distance", "planned", "commanded", "line")}
     w = op.waypoints
     # a move starts when its waypoint started plus the moves of that waypoint before it
     dur = r.duration_t
@@ -157,10 +163,10 @@ def velocity_profile(op: "Operation") -> "pd.DataFrame":
     dist = np.column_stack([d0, d0 + accel_d, d0 + d - decel_d, d0 + d])
     speed = np.column_stack([r.start_v, r.cruise_v, r.cruise_v, r.end_v])
     commanded = np.repeat(moves.speed_v, 4)
-    return pd.DataFrame({
+    return {
         "time": times.ravel(), "distance": dist.ravel(), "planned": speed.ravel(), "commanded": commanded,
         "line": np.repeat(op.table.line[moves.row], 4),
-    })
+    }
 
 
 _PART_NAME = re.compile(r"Part name:\s*(.+)")

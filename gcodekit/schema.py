@@ -83,6 +83,10 @@ DERIVED_COLUMNS: tuple[Column, ...] = (
     Column("accel", "mm/s^2", "float64", "acceleration the planner used for the step's first move"),
     Column("deposited_volume", "mm^3", "float64", "material laid by the step (additive processes; NaN when "
                                                    "the machine does not say how much)"),
+    Column("removed_volume", "mm^3", "float64", "material the step's move removed from the stock (once a cutting "
+                                                 "simulation has run, gcodekit.cut; 0 for moves in the air)"),
+    Column("removal_rate", "mm^3/min", "float64", "material removal rate: removed_volume over the step's planned "
+                                                   "time (0 where the step takes no time; once a cut has run)"),
 )
 
 COLUMNS: dict[str, Column] = {c.name: c for c in COMMAND_COLUMNS + WAYPOINT_COLUMNS + DERIVED_COLUMNS}

@@ -8,6 +8,7 @@ SwiftShader for WebGL.  Also used by ``benchmarks/bench_widgets.py``.
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import shutil
@@ -18,6 +19,8 @@ import time
 import urllib.request
 from contextlib import contextmanager
 from pathlib import Path
+
+import numpy as np
 
 #: WebGL through SwiftShader (no GPU here) with the page composited in software, as Chromium does by
 #: itself on a machine without a GPU: compositing whole pages through SwiftShader cost 150-400 ms a
@@ -100,8 +103,11 @@ def browser_page(width: int = 1400, height: int = 1000):
             browser.close()
 
 
-def open_and_run(page, url: str, notebook: str, timeout_s: float = 240.0) -> None:
-    """Open ``notebook`` in JupyterLab and run all its cells, waiting until none is busy."""
+def open_and_run(page, url: str, notebook: str, timeout_s: float = 240.0, before_run=None) -> None:
+    """Open ``notebook`` in JupyterLab and run all its cells, waiting until none is busy.
+
+    ``before_run(page)``, when given, is called once the kernel is idle, just before the cells run.
+    """
     page.goto(f"{url}/lab/tree/{notebook}?reset")
     page.wait_for_function("window.jupyterapp && document.querySelector('.jp-NotebookPanel .jp-Cell')",
                            timeout=timeout_s * 1000)
@@ -109,6 +115,8 @@ def open_and_run(page, url: str, notebook: str, timeout_s: float = 240.0) -> Non
     page.wait_for_function("document.querySelector('.jp-NotebookPanel') && "
                            "window.jupyterapp.shell.currentWidget?.sessionContext?.session?.kernel?.status === 'idle'",
                            timeout=timeout_s * 1000)
+    if before_run is not None:
+        before_run(page)
     page.evaluate("window.jupyterapp.commands.execute('notebook:run-all-cells')")
     page.wait_for_timeout(500)
     page.wait_for_function(
@@ -124,3 +132,53 @@ def delete_sessions(url: str) -> None:
     for s in sessions:
         request = urllib.request.Request(f"{url}/api/sessions/{s['id']}", method="DELETE")
         urllib.request.urlopen(request).close()
+
+
+def shot(locator):
+    """A screenshot of ``locator`` as an (height, width, 3) int array."""
+    from PIL import Image
+
+    return np.asarray(Image.open(io.BytesIO(locator.screenshot())).convert("RGB"), dtype=int)
+
+
+def wait_for_picture(frame, previous, timeout_s=120.0):
+    """Poll the view until its picture differs from ``previous``; the new picture and the seconds waited."""
+    start = time.perf_counter()
+    while time.perf_counter() - start < timeout_s:
+        now = shot(frame)
+        if np.mean(np.any(now != previous, axis=2)) > 0.002:
+            waited = time.perf_counter() - start
+            time.sleep(0.5)  # then let it settle
+            return shot(frame), waited
+        time.sleep(0.05)
+    raise AssertionError("the view's picture did not change")
+
+
+def settled(frame, timeout_s=30.0):
+    """The view's picture once two screenshots half a second apart agree (it has finished drawing)."""
+    before = shot(frame)
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        time.sleep(0.5)
+        now = shot(frame)
+        if np.array_equal(now, before):
+            return now
+        before = now
+    return before
+
+
+def drag_turns(page, frame, before, attempts=3):
+    """Drag across the view's middle until its picture changes (a view still loading may miss the first drag)."""
+    box = frame.bounding_box()
+    cx, cy = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    for attempt in range(attempts):
+        page.mouse.move(cx, cy)
+        page.mouse.down()
+        page.mouse.move(cx + 160, cy + 40, steps=12)
+        page.mouse.up()
+        try:
+            return wait_for_picture(frame, before, timeout_s=90)[0]
+        except AssertionError:
+            if attempt == attempts - 1:
+                raise
+    raise AssertionError("unreachable")

@@ -7,7 +7,6 @@ press on the slider to the new picture is printed (and kept in
 ``part_view_timing.txt`` in the test's folder).
 """
 
-import io
 import json
 import shutil
 import time
@@ -20,7 +19,7 @@ pytest.importorskip("jupyterlab")
 pytest.importorskip("playwright")
 pytest.importorskip("trame_pyvista")
 
-from jupyter_browser import browser_page, chromium_path, jupyter_lab, open_and_run  # noqa: E402
+from jupyter_browser import browser_page, chromium_path, jupyter_lab, open_and_run, shot, wait_for_picture  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -39,12 +38,6 @@ def _notebook(path: Path) -> None:
                                 "nbformat": 4, "nbformat_minor": 5}))
 
 
-def shot(locator) -> np.ndarray:
-    from PIL import Image
-
-    return np.asarray(Image.open(io.BytesIO(locator.screenshot())).convert("RGB"), dtype=int)
-
-
 def cut_colour(image) -> np.ndarray:
     """Pixels of cut surfaces: viridis' greens and blues (uncut stock is its yellow end, the page white).
 
@@ -52,19 +45,6 @@ def cut_colour(image) -> np.ndarray:
     image = image[:, : int(0.85 * image.shape[1])]
     r, g, b = image[..., 0], image[..., 1], image[..., 2]
     return (b > r + 30) & (b > 60)
-
-
-def wait_for_picture(frame, previous, timeout_s=60.0):
-    """Poll the view until its picture differs from ``previous``; the new picture and the seconds waited."""
-    start = time.perf_counter()
-    while time.perf_counter() - start < timeout_s:
-        now = shot(frame)
-        if np.mean(np.any(now != previous, axis=2)) > 0.002:
-            waited = time.perf_counter() - start
-            time.sleep(0.5)  # then let it settle
-            return shot(frame), waited
-        time.sleep(0.05)
-    raise AssertionError("the view's picture did not change")
 
 
 @pytest.fixture(scope="module")

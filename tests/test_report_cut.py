@@ -56,3 +56,26 @@ def test_mill_page_shows_the_part_and_volumes(tmp_path):
     part = np.any(image < 240, axis=2)
     assert 0.15 < part.mean() < 0.9
     assert len(np.unique(image[part], axis=0)) > 50
+
+
+def test_the_page_lists_the_moves_that_remove_fastest(tmp_path):
+    op = gcodekit.gcode_to_operation(MILL)
+    cut = report_data(op, transpile=False)["cut"]
+    # the report's cut gave the operation its columns; the page's figures are read from them
+    rate, removed = op.waypoints["removal_rate"], op.waypoints["removed_volume"]
+    lines = np.asarray(op.table.line)[op.waypoints["command"]]
+    top = cut["top_moves"]
+    assert len(top) == 5 and top[0]["rate"] == pytest.approx(rate.max())
+    assert [m["rate"] for m in top] == sorted((m["rate"] for m in top), reverse=True)
+    for move in top:
+        k = int(np.flatnonzero((lines == move["line"]) & np.isclose(rate, move["rate"]))[0])
+        assert move["removed_mm3"] == pytest.approx(removed[k])
+    cutting = removed > 0
+    assert cut["mean_rate"] == pytest.approx(removed.sum() / (op.waypoints["time"][cutting].sum() / 60), rel=1e-9)
+
+    from gcodekit.report.batch import ReportOptions, write_reports
+
+    write_reports([MILL], tmp_path, options=ReportOptions(pdf=False))
+    section = (tmp_path / "bracket_mill.ngc.html").read_text().split("<h2>Material removal</h2>", 1)[1]
+    assert "Removal rate" in section and "mm³/min" in section
+    assert f"<td>{top[0]['line']}</td>" in section.split('class="top-moves"', 1)[1]

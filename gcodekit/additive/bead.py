@@ -37,6 +37,60 @@ def bead_area(width, height, shape: str = "stadium"):
     return area if area.ndim else float(area)
 
 
+def bead_width(area, height, shape: str = "stadium"):
+    """The width of beads of cross-section ``area`` (mm^2) and ``height`` (mm): :func:`bead_area` solved for it.
+
+    A stadium narrower than it is high has no such shape: its width is then
+    the height (a round bead, somewhat larger than ``area``).
+    """
+    check_choice("shape", shape, SHAPES)
+    a, h = np.asarray(area, float), np.asarray(height, float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        if shape == "rectangle":
+            width = a / h
+        elif shape == "ellipse":
+            width = 4.0 * a / (np.pi * h)
+        else:
+            width = np.maximum((a - np.pi * h * h / 4.0) / h + h, h)
+    return width if width.ndim else float(width)
+
+
+def bead_outline(width, height, shape: str = "stadium", sides: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Points on the outline of beads' cross-sections, about the bead's centre: ``(lateral, vertical)``, mm.
+
+    Each has shape ``(n, sides)`` for ``n`` beads (``width`` and ``height``
+    arrays or scalars), going counter-clockwise seen along the bead from
+    behind, at the angles ``pi / sides + 2 pi k / sides`` from the lateral
+    axis (an even ``sides`` gives a flat top and bottom).  The stadium's
+    points lie on its two half circles, the ellipse's on the ellipse; the
+    rectangle's on its sides, starting at its corner (angle ``pi / 4``)
+    when ``sides`` is a multiple of 4, so that it has its four corners.
+
+    Examples
+    --------
+    >>> lateral, vertical = bead_outline(0.45, 0.2, "rectangle", sides=4)
+    >>> lateral.round(3).tolist(), vertical.round(3).tolist()
+    ([[0.225, -0.225, -0.225, 0.225]], [[0.1, 0.1, -0.1, -0.1]])
+    """
+    check_choice("shape", shape, SHAPES)
+    if sides < 3:
+        raise ConfigError(f"a bead's outline needs at least 3 sides, not {sides}")
+    w, h = np.atleast_1d(np.asarray(width, float))[:, None], np.atleast_1d(np.asarray(height, float))[:, None]
+    offset = np.pi / 4 if shape == "rectangle" and sides % 4 == 0 else np.pi / sides
+    angle = offset + 2.0 * np.pi * np.arange(sides) / sides
+    c, s = np.cos(angle), np.sin(angle)
+    if shape == "stadium":
+        lateral = np.sign(c) * (w - h) / 2.0 + h / 2.0 * c
+        vertical = h / 2.0 * s + 0.0 * w
+    elif shape == "ellipse":
+        lateral, vertical = w / 2.0 * c, h / 2.0 * s
+    else:
+        # the circle's points pushed out to the square, then stretched to the rectangle
+        scale = 1.0 / np.maximum(np.abs(c), np.abs(s))
+        lateral, vertical = w / 2.0 * c * scale, h / 2.0 * s * scale
+    return lateral, vertical
+
+
 @dataclass(frozen=True)
 class Bead:
     """A constant bead cross-section laid along the deposition paths.

@@ -240,9 +240,17 @@ class CutSimulation:
         return self.top
 
     def run(self) -> CutResult:
-        """Cut the whole program; the :class:`CutResult`."""
+        """Cut the whole program; the :class:`CutResult`.
+
+        The operation gains the per-waypoint columns ``removed_volume``
+        (mm^3) and ``removal_rate`` (mm^3/min) (see
+        :meth:`~gcodekit.model.operation.Operation.attach_removal`), so that
+        ``op.to_dataframe()`` and ``op.volumes()`` report them.
+        """
         self.cut_to(self.n_waypoints - 1)
-        return self.result()
+        result = self.result()
+        self.op.attach_removal(result.removed, result.removal_rate)
+        return result
 
     def result(self) -> CutResult:
         """What the cut so far has made (:meth:`cut_to` sets how far)."""
@@ -262,6 +270,9 @@ class CutSimulation:
 
 def cut(op, *, stock: Stock | None = None, tools: ToolLibrary | None = None, resolution: float | None = None,
         tolerance: float | None = None, engine: str = "auto") -> CutResult:
-    """Cut the stock with the whole program; see :class:`CutSimulation` for the parameters."""
+    """Cut the stock with the whole program; see :class:`CutSimulation` for the parameters.
+
+    The operation gains the columns ``removed_volume`` and ``removal_rate`` (see :meth:`CutSimulation.run`).
+    """
     return CutSimulation(op, stock=stock, tools=tools, resolution=resolution, tolerance=tolerance,
                          engine=engine).run()

@@ -45,6 +45,8 @@ if TYPE_CHECKING:
 
 #: Columns only a planned operation has
 _PLANNED = ("start_v", "cruise_v", "end_v", "accel")
+#: Columns only an operation a cutting simulation has run over has (:meth:`Operation.attach_removal`)
+REMOVAL_COLUMNS = ("removed_volume", "removal_rate")
 
 
 class Operation:
@@ -163,7 +165,9 @@ class Operation:
         """
         import pandas as pd
 
-        shown = [c for c in COLUMNS.values() if self.plan is not None or c.name not in _PLANNED]
+        w = self.waypoints or {}
+        shown = [c for c in COLUMNS.values() if (self.plan is not None or c.name not in _PLANNED)
+                 and (c.name in w or c.name not in REMOVAL_COLUMNS)]
         return pd.DataFrame({"unit": [c.unit for c in shown], "dtype": [c.dtype for c in shown],
                              "meaning": [c.meaning for c in shown]},
                             index=pd.Index([c.name for c in shown], name="column"))
@@ -242,6 +246,28 @@ class Operation:
         self.waypoints["time"] = plan.time
         self.plan = (plan.moves, plan.result)
         self._derived.pop("elapsed_time", None)
+
+    def attach_removal(self, removed_volume: np.ndarray, removal_rate: np.ndarray) -> None:
+        """Take a cutting simulation's per-waypoint columns: ``removed_volume`` (mm^3) and ``removal_rate`` (mm^3/min).
+
+        :func:`gcodekit.cut.cut` (and :meth:`gcodekit.cut.CutSimulation.run`)
+        call this once the whole program is cut; the columns then show in
+        :meth:`to_dataframe`, :meth:`volumes` and the process data.
+
+        Raises
+        ------
+        ValueError
+            Before emulation, or columns of another length than the waypoints.
+        """
+        if self.waypoints is None:
+            raise ValueError(f"{self.file}: attach_removal() needs an emulated operation")
+        n = len(self.waypoints["x"])
+        columns = {"removed_volume": removed_volume, "removal_rate": removal_rate}
+        for name, values in columns.items():
+            values = np.asarray(values, COLUMNS[name].dtype)
+            if values.shape != (n,):
+                raise ValueError(f"{name} has {values.shape} values for {n} waypoints")
+            self.waypoints[name] = values
 
     # -- summaries ----------------------------------------------------------------
 
@@ -385,8 +411,9 @@ class Operation:
         data["elapsed_time"] = self.elapsed_time()
         data["start_time"] = data["elapsed_time"] - np.nan_to_num(np.asarray(w["time"], float))
         data["layer"], data["feature"], data["depositing"] = self.layers, self.features, self.depositing
-        if "power" in w:  # laser machines
-            data["power"] = w["power"]
+        for name in ("power", *REMOVAL_COLUMNS):  # laser machines; once a cut has run
+            if name in w:
+                data[name] = w[name]
         return pd.DataFrame(data, copy=False)
 
     def _codes(self) -> np.ndarray:

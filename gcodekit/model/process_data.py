@@ -71,7 +71,8 @@ class SubtractiveProcessData(ProcessData):
     spindle_speed : float
         rpm, negative when counter-clockwise.
     removed_volume : float or None
-        None until material removal is modelled.
+        Material the step removed, mm^3, once a cutting simulation has run
+        (:func:`gcodekit.cut.cut`); None before.
     """
 
     spindle_speed: float = 0.0

@@ -151,7 +151,9 @@ class SubtractiveOperation(Operation):
 
     def _process_fields(self, k: int, columns: dict[str, np.ndarray]) -> dict[str, Any]:
         fields = super()._process_fields(k, columns)
-        fields.update(spindle_speed=float(self.waypoints["spindle"][k]), removed_volume=None)
+        removed = self.waypoints.get("removed_volume")
+        fields.update(spindle_speed=float(self.waypoints["spindle"][k]),
+                      removed_volume=None if removed is None else float(removed[k]))
         return fields
 
 

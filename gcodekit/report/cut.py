@@ -16,6 +16,8 @@ from typing import Any
 
 #: Cells the report's cut grid may have at most (2,000 x 2,000).
 REPORT_MAX_CELLS = 4_000_000
+#: Moves of the highest removal rate listed on the page.
+TOP_MOVES = 5
 
 
 def tools_for(op):
@@ -46,6 +48,25 @@ def cut_section(op) -> dict[str, Any] | None:
     if not math.isfinite(result.stock_mm3) or result.stock_mm3 <= 0:
         return None
     summary = result.summary()
+    summary.update(removal_rates(result))
     summary["notes"] = [{"line": d.line, "severity": d.severity, "message": d.message} for d in result.notes[:20]]
     summary["result"] = result
     return summary
+
+
+def removal_rates(result, top: int = TOP_MOVES) -> dict[str, Any]:
+    """The removal rate figures of the page: ``cutting_s`` (time of the moves that cut), ``mean_rate``
+    (removed volume over it, mm^3/min) and ``top_moves`` (the ``top`` moves of the highest rate, each
+    ``{"line", "motion", "removed_mm3", "rate"}``)."""
+    import numpy as np
+
+    from ..parse.table import MOTION_NAMES
+
+    cutting = np.flatnonzero(result.cutting)
+    cutting_s = float(result.time[cutting].sum())
+    rate = result.removal_rate
+    best = cutting[np.argsort(-rate[cutting], kind="stable")[:top]]
+    return {"cutting_s": cutting_s,
+            "mean_rate": result.removed_mm3 / (cutting_s / 60) if cutting_s > 0 else 0.0,
+            "top_moves": [{"line": int(result.lines[r]), "motion": MOTION_NAMES[int(result.motion[r])],
+                           "removed_mm3": float(result.removed[r]), "rate": float(rate[r])} for r in best]}

@@ -24,10 +24,11 @@ Examples
 from .camera import CAMERAS, Camera
 from .coloring import (PALETTE, TITLES, TRAVEL_COLOR, Coloring, choices, colormap_table, coloring, default_coloring,
                        has_features, palette_rgb, waypoint_scalars)
-from .toolpath import (CHORD_ANGLE_DEG, GROUP_BY, TRAVEL, WORK, Toolpath, ToolpathError, move_masks, move_segments,
-                       source_lines)
+from .overview import overview
+from .toolpath import (CHORD_ANGLE_DEG, GROUP_BY, TRAVEL, WORK, Toolpath, ToolpathError, move_masks, move_rows,
+                       move_segments, source_lines)
 
 __all__ = ["CAMERAS", "CHORD_ANGLE_DEG", "GROUP_BY", "PALETTE", "TITLES", "TRAVEL", "TRAVEL_COLOR", "WORK", "Camera",
            "Coloring", "Toolpath", "ToolpathError", "choices", "colormap_table", "coloring", "default_coloring",
-           "has_features", "move_masks", "move_segments", "palette_rgb", "source_lines",
+           "has_features", "move_masks", "move_rows", "move_segments", "overview", "palette_rgb", "source_lines",
            "waypoint_scalars"]

@@ -98,11 +98,18 @@ def choices(path: Toolpath) -> list[str]:
     named += ["time", "tool"]
     if op.process == "additive":
         named.append("flow")
-    rows = path.move_rows
-    # a column that never changes over the moves would paint everything one colour
+    moves = np.zeros(len(op.waypoints["x"]), bool)
+    moves[path.move_rows] = True
+    # a column that never changes over the moves would paint everything one colour (reduced in place: no copies)
     columns = sorted(k for k, v in op.waypoints.items()
-                     if k not in HIDDEN and k not in named and np.ptp(np.asarray(v, float)[rows]) > 0)
+                     if k not in HIDDEN and k not in named and _varies(np.asarray(v), moves))
     return named + columns
+
+
+def _varies(values: np.ndarray, where: np.ndarray) -> bool:
+    if values.dtype.kind != "f":
+        values = values.astype(float)
+    return bool(values.max(where=where, initial=-np.inf) > values.min(where=where, initial=np.inf))
 
 
 @dataclass
@@ -196,8 +203,10 @@ def coloring(path: Toolpath, by: str) -> Coloring:
             tools, per_move = np.unique(per_move, return_inverse=True)
             categories = [f"T{int(t)}" for t in tools]
     if categories is not None:
-        used, per_move = np.unique(per_move.astype(np.int64), return_inverse=True)
-        categories = [categories[k] for k in used]
+        codes = per_move.astype(np.int64)
+        present = np.bincount(codes, minlength=len(categories)) > 0
+        per_move = (np.cumsum(present) - 1)[codes]  # the categories renumbered in order, as np.unique would
+        categories = [categories[k] for k in np.flatnonzero(present)]
     return Coloring(by, per_move.astype(np.float32)[path.move_of], categories, TITLES.get(by, by))
 
 

@@ -56,6 +56,26 @@ def move_masks(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
     return work, moving & ~work
 
 
+def move_rows(op: "Operation") -> tuple[np.ndarray, np.ndarray]:
+    """Waypoint rows that end a move (the moves every picture draws), and :func:`move_masks`' work mask.
+
+    Raises
+    ------
+    ToolpathError
+        When the operation is not emulated or has no motion to draw.
+    """
+    w = getattr(op, "waypoints", None)
+    if w is None:
+        raise ToolpathError(f"{op.file}: the operation is not emulated (use gcode_to_operation)")
+    if len(w["x"]) == 0:
+        raise ToolpathError(f"{op.file}: nothing to draw (the program is empty: no commands to run)")
+    work, travel = move_masks(op)
+    rows = np.flatnonzero(work | travel)
+    if rows.size == 0:
+        raise ToolpathError(f"{op.file}: nothing to draw (the program has no motions)")
+    return rows, work
+
+
 @dataclass
 class Toolpath:
     """Segments of an emulated operation, in program order.
@@ -110,17 +130,9 @@ class Toolpath:
         op = getattr(source, "operation", source)  # an AdditivePart draws its operation with its layers
         waypoint_layer = getattr(source, "waypoint_layer", None)
         w = getattr(op, "waypoints", None)
-        if w is None:
-            raise ToolpathError(f"{op.file}: the operation is not emulated (use gcode_to_operation)")
-        if len(w["x"]) == 0:
-            raise ToolpathError(f"{op.file}: nothing to draw (the program is empty: no commands to run)")
-        work, travel = move_masks(op)
-        moving = work | travel
-        if not moving.any():
-            raise ToolpathError(f"{op.file}: nothing to draw (the program has no motions)")
+        rows, work = move_rows(op)
         group_by = group_by or ("layer" if op.process == "additive" else "z")
         check_choice("group_by", group_by, GROUP_BY)
-        rows = np.flatnonzero(moving)
         key, labels = _group_keys(op, rows, work[rows], group_by, waypoint_layer)
         start, end, move_of = move_segments(w, rows)
         group_move = np.searchsorted(key, np.arange(len(labels) + 1))
@@ -171,18 +183,20 @@ class Toolpath:
         Travel to a parking or home position would otherwise shrink the part to a dot.
         """
         if keep is None:
-            lo, hi = self._work_bounds
-            return lo.copy(), hi.copy()
-        both = np.vstack([self.start[keep], self.end[keep]])
-        if both.size == 0:
-            return np.zeros(3), np.zeros(3)
-        return both.min(axis=0), both.max(axis=0)
+            return tuple(a.copy() for a in self._work_bounds)
+        return _corners(self.start[keep], self.end[keep])
 
     @cached_property
     def _work_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`bounds` of the work, once: every picture and camera asks (a copy of 3 M segments each time)."""
+        """:meth:`bounds` of the work, once: every picture and camera asks."""
         work = self.kind == WORK
-        return self.bounds(work if work.any() else slice(None))
+        if not work.any():
+            return _corners(self.start, self.end)
+        # reduced in place (a copy of millions of selected points costs more than the reduction)
+        mask = work[:, None]
+        lo = [p.min(axis=0, where=mask, initial=np.inf) for p in (self.start, self.end)]
+        hi = [p.max(axis=0, where=mask, initial=-np.inf) for p in (self.start, self.end)]
+        return np.minimum(*lo), np.maximum(*hi)
 
     def frame(self) -> tuple[np.ndarray, float]:
         """Centre of :meth:`bounds` and the radius of the sphere around them, mm."""
@@ -194,6 +208,12 @@ class Toolpath:
         w = self.op.waypoints
         end = self.op.elapsed_time()[self.move_rows]
         return end - np.nan_to_num(np.asarray(w["time"], float)[self.move_rows]), end
+
+
+def _corners(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    if start.shape[0] == 0:
+        return np.zeros(3), np.zeros(3)
+    return np.minimum(start.min(axis=0), end.min(axis=0)), np.maximum(start.max(axis=0), end.max(axis=0))
 
 
 def _command_rows(op: "Operation") -> np.ndarray:
@@ -234,22 +254,23 @@ def move_segments(w: dict, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np
     """
     from ..emulate.arcs import waypoint_arc_points
 
-    xyz = np.column_stack([np.asarray(w[k], float) for k in "xyz"])
     interior, counts = waypoint_arc_points(w, rows, np.radians(CHORD_ANGLE_DEG))
-    points_per_move = counts + 2  # its start, the arc's interior points, its end
-    offsets = np.r_[0, np.cumsum(points_per_move)]
-    points = np.empty((int(offsets[-1]), 3))
-    points[offsets[:-1]] = xyz[rows - 1]
-    points[offsets[1:] - 1] = xyz[rows]
-    inside = np.ones(points.shape[0], bool)
-    inside[offsets[:-1]] = inside[offsets[1:] - 1] = False
-    points[inside] = interior
-    # a segment joins each point to the next one of the same move
-    joins = np.ones(points.shape[0], bool)
-    joins[offsets[1:] - 1] = False
-    seg_start = np.flatnonzero(joins)
-    move_of = np.repeat(np.arange(rows.size), points_per_move - 1)
-    return points[seg_start], points[seg_start + 1], move_of
+    before = np.column_stack([np.asarray(w[k], float)[rows - 1] for k in "xyz"])
+    after = np.column_stack([np.asarray(w[k], float)[rows] for k in "xyz"])
+    if interior.shape[0] == 0:  # no arcs: one segment per move
+        return before, after, np.arange(rows.size)
+    # a move's segments join its start, the arc's interior points and its end, in order
+    offsets = np.r_[0, np.cumsum(counts + 1)]
+    first, last = offsets[:-1], offsets[1:] - 1
+    start, end = np.empty((int(offsets[-1]), 3)), np.empty((int(offsets[-1]), 3))
+    start[first], end[last] = before, after
+    inside = np.ones(start.shape[0], bool)
+    inside[first] = False
+    start[inside] = interior  # every segment but a move's first starts at an interior point
+    inside[:] = True
+    inside[last] = False
+    end[inside] = interior  # and every one but its last ends at one
+    return start, end, np.repeat(np.arange(rows.size), counts + 1)
 
 
 

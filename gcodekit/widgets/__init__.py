@@ -7,7 +7,9 @@
 - :class:`VelocityPlot`: commanded feed against planned speed, decimated,
   following a viewer's range;
 - :class:`PartView`: the part a mill program cuts, in a live 3D view (trame,
-  vtk.js in the browser), with a slider over the moves.
+  vtk.js in the browser), with a slider over the moves;
+- :class:`BeadView`: the beads an additive program lays, as shaded tubes in
+  the same kind of live view, with a slider over the depositing moves.
 
 They need the ``widgets`` extra (``pip install 'gcodekit[widgets]'``), load
 on first use (``import gcodekit`` does not import them) and are plain Python
@@ -21,7 +23,7 @@ from __future__ import annotations
 from importlib import import_module
 
 _WIDGETS = {"LayerViewer": ".layer_viewer", "StageDiff": ".stage_diff", "VelocityPlot": ".velocity",
-            "PartView": ".part_view"}
+            "PartView": ".part_view", "BeadView": ".bead_view"}
 
 __all__ = list(_WIDGETS)
 

@@ -5,11 +5,20 @@ anywidget front end): they are sent once, and the sliders are linked to the
 view in the browser, so a slider step redraws a range without a round trip
 to the kernel.  The kernel follows the same sliders for what it owns: the
 move slider's length, the source lines beside the view, ``screenshot()``.
+
+A program of more than ``max_segments`` segments is sent as an overview of
+at most that many chords (:func:`gcodekit.view.overview`), and the top
+layer of the range shown, the one the move slider steps through, at full
+detail when the view asks for it (a message per layer, kept in the browser):
+the browser gets at most ``max_segments`` chords of 33 bytes at the start
+and one layer's segments (33 bytes each, 4 per move) per layer visited.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import html
+import threading
 from pathlib import Path
 
 import anywidget
@@ -17,23 +26,40 @@ import ipywidgets as widgets
 import numpy as np
 import traitlets
 
-from ..view import Camera, Coloring, Toolpath, ToolpathError, choices, coloring, source_lines
+from ..view import Camera, Coloring, Toolpath, ToolpathError, choices, coloring, overview, source_lines
 from .display import PictureDisplay, friendly, message_html
 from .picture import message_figure, toolpath_figure
 from .toolpath import load_toolpath
 
 #: Source lines shown around the current one.
 CONTEXT_LINES = 6
+#: Most segments sent to the browser at once (the overview's budget): 33 bytes each, 8.3 MB.
+MAX_SEGMENTS = 250_000
+#: Program files up to this size are read for their source lines at once; larger ones on a thread.
+SOURCE_BYTES_NOW = 4_000_000
+#: Bytes per segment sent: 2 x 3 float32 positions, its kind (uint8), value (float32) and move (int32).
+SEGMENT_BYTES = 33
 
 
 class ToolpathView(anywidget.AnyWidget):
-    """The WebGL view: segment buffers, what range to draw, colours and camera."""
+    """The WebGL view: segment buffers, what range to draw, colours and camera.
+
+    ``positions``, ``kinds``, ``values`` and ``seg_move`` (the first move of
+    each) are the overview's chords, every segment when ``stride`` is 1;
+    ``group_seg`` and ``group_move`` are each group's first chord and move.
+    A layer's own segments go out in a ``{"detail": group}`` message when
+    the view asks for them.
+    """
 
     _esm = Path(__file__).parent / "static" / "viewer.js"
     positions = traitlets.Bytes(b"").tag(sync=True)
     kinds = traitlets.Bytes(b"").tag(sync=True)
-    move_seg = traitlets.Bytes(b"").tag(sync=True)
+    seg_move = traitlets.Bytes(b"").tag(sync=True)
+    group_seg = traitlets.Bytes(b"").tag(sync=True)
     group_move = traitlets.Bytes(b"").tag(sync=True)
+    stride = traitlets.Int(1).tag(sync=True)
+    #: counts the colourings sent: a layer's detail answers one of them
+    color_version = traitlets.Int(0).tag(sync=True)
     group_labels = traitlets.List(traitlets.Unicode()).tag(sync=True)
     values = traitlets.Bytes(b"").tag(sync=True)
     palette = traitlets.Bytes(b"").tag(sync=True)
@@ -65,6 +91,9 @@ class LayerViewer(PictureDisplay):
     show_travel : bool, default: False
     height : int, default: 480
         Height of the view in pixels.
+    max_segments : int, default: MAX_SEGMENTS
+        Most segments the browser gets at once: a larger program is sent as
+        an overview of that many chords and the top layer in full detail.
 
     Attributes
     ----------
@@ -89,11 +118,14 @@ class LayerViewer(PictureDisplay):
     """
 
     def __init__(self, source, color_by: str = "feature", *, group_by: str | None = None,
-                 show_travel: bool = False, height: int = 480):
+                 show_travel: bool = False, height: int = 480, max_segments: int = MAX_SEGMENTS):
         self.error: str | None = None
+        self.max_segments = max(int(max_segments), 1)
+        self.details_sent = 0
         self.path: Toolpath | None = None
         self.camera = Camera()
         self._lines: list[str] | None = None
+        self._reading: threading.Thread | None = None
         try:
             self.path = load_toolpath(source, group_by)
         except ToolpathError as exc:
@@ -144,6 +176,7 @@ class LayerViewer(PictureDisplay):
         self.travel.observe(lambda change: setattr(self.view, "show_travel", change["new"]), "value")
         self.view.observe(self._on_camera, "camera")
         self.view.observe(self._on_view_move, "top_move")
+        self.view.on_msg(self._on_message)
         self._show_code()
         controls = widgets.HBox([self.color_by, self.travel, self.play])
         self.widget = widgets.VBox([controls, self.layers, self.moves,
@@ -153,24 +186,52 @@ class LayerViewer(PictureDisplay):
 
     def _send_geometry(self) -> None:
         path = self.path
-        middle, radius = path.frame()
-        xyz = np.stack([path.start - middle, path.end - middle], axis=1).astype(np.float32)
+        self._middle, radius = path.frame()
         with self.view.hold_sync():
-            self.view.positions = xyz.tobytes()
-            self.view.kinds = path.kind.astype(np.uint8).tobytes()
-            self.view.move_seg = path.move_seg.astype(np.int32).tobytes()
             self.view.group_move = path.group_move.astype(np.int32).tobytes()
             self.view.group_labels = path.group_labels
             self.view.radius = radius
             self.view.camera = self.camera.as_dict()
 
     def _recolor(self) -> None:
-        self._coloring = color = coloring(self.path, self.color_by.value)
+        """Colour by the dropdown's choice: the overview's chords (their runs keep one colour) and their values."""
+        path = self.path
+        self._coloring = color = coloring(path, self.color_by.value)
+        key = np.column_stack([path.segment_group, path.kind, color.values])
+        first, last, stride = overview(path.start, path.end, key, self.max_segments)
+        self._chords = first, last
+        chord_group = path.segment_group[first]
         with self.view.hold_sync():
-            self.view.values = color.values.astype(np.float32).tobytes()
+            self.view.positions = self._positions(path.start[first], path.end[last])
+            self.view.kinds = path.kind[first].astype(np.uint8).tobytes()
+            self.view.values = color.values[first].astype(np.float32).tobytes()
+            self.view.seg_move = path.move_of[first].astype(np.int32).tobytes()
+            self.view.group_seg = np.searchsorted(chord_group, np.arange(path.n_groups + 1)).astype(np.int32).tobytes()
+            self.view.stride = stride
             self.view.palette = color.table().tobytes()
             self.view.categories = color.categories or []
             self.view.title = color.title
+            self.view.color_version += 1
+
+    def _positions(self, start: np.ndarray, end: np.ndarray) -> bytes:
+        return np.stack([start - self._middle, end - self._middle], axis=1).astype(np.float32).tobytes()
+
+    def _on_message(self, view, content, buffers) -> None:
+        """The view asks for a layer's own segments: send them, with the colouring they answer."""
+        group = content.get("detail") if isinstance(content, dict) else None
+        if not isinstance(group, int) or not 0 <= group < self.path.n_groups:
+            return
+        self.view.send({"detail": group, "version": self.view.color_version}, self.detail(group))
+        self.details_sent += 1
+
+    def detail(self, group: int) -> list[bytes]:
+        """Group ``group``'s segments as sent to the view: positions, kinds, values and each move's first segment."""
+        path = self.path
+        moves = path.group_move[group], path.group_move[group + 1]
+        a, b = int(path.move_seg[moves[0]]), int(path.move_seg[moves[1]])
+        return [self._positions(path.start[a:b], path.end[a:b]), path.kind[a:b].astype(np.uint8).tobytes(),
+                self._coloring.values[a:b].astype(np.float32).tobytes(),
+                (path.move_seg[moves[0]:moves[1] + 1] - a).astype(np.int32).tobytes()]
 
     # -- following the controls -----------------------------------------------------
 
@@ -232,8 +293,10 @@ class LayerViewer(PictureDisplay):
         if line is None:
             self.code.value = "<i>no move in this range</i>"
             return
-        if self._lines is None:
-            self._lines = source_lines(self.path.op) or []
+        if self._lines is None and not self._read_lines():
+            self.code.value = (f'<div class="gcodekit-code" data-line="{line}" style="font:12px monospace">'
+                               f'line {line}, move {self.current_move}<br><i>reading the program ...</i></div>')
+            return
         rows = []
         if self._lines:
             first = max(line - CONTEXT_LINES, 1)
@@ -247,16 +310,48 @@ class LayerViewer(PictureDisplay):
         self.code.value = (f'<div class="gcodekit-code" data-line="{line}" style="font:12px monospace;'
                            f'white-space:pre">line {line}, move {self.current_move}<br>{"".join(rows)}</div>')
 
+    def _read_lines(self) -> bool:
+        """Whether the source lines are read; a large file is read on a thread, which shows them when done."""
+        path = Path(self.path.op.file)
+        if not path.is_file() or path.stat().st_size <= SOURCE_BYTES_NOW:
+            self._lines = source_lines(self.path.op) or []
+            return True
+        if self._reading is None:
+            def read():
+                self._lines = source_lines(self.path.op) or []
+                self._show_code()
+
+            self._reading = threading.Thread(target=read, name="gcodekit-source-lines", daemon=True)
+            self._reading.start()
+        return False
+
     def figure(self, size: tuple[int, int] = (800, 600)):
-        """The current picture as a matplotlib Figure (what :meth:`screenshot` returns)."""
+        """The current picture as a matplotlib Figure (what :meth:`screenshot` returns).
+
+        A program sent as an overview is drawn from the overview's chords (as
+        the browser draws it before a layer's own segments arrive).
+        """
         if self.error is not None:
             return message_figure(self.error)
         lo, hi = self.layers.value
+        labels = self.path.group_labels
         name = Path(self.path.op.file).name
-        what = self.path.group_labels[lo] if lo == hi else f"{self.path.group_labels[lo]} to {self.path.group_labels[hi]}"
-        return toolpath_figure(self.path, self.span, self._coloring, self.camera, show_travel=self.travel.value,
-                               current_move=self.current_move, size=size,
+        what = labels[lo] if lo == hi else f"{labels[lo]} to {labels[hi]}"
+        path, color = self._drawn()
+        return toolpath_figure(path, path.group_slice(lo, hi, self.moves.value), color, self.camera,
+                               show_travel=self.travel.value, current_move=self.current_move, size=size,
                                title=f"{name}: {what}, move {self.moves.value + 1} of {self.moves.max + 1}")
+
+    def _drawn(self) -> tuple[Toolpath, Coloring]:
+        """The toolpath and colouring pictures draw: the program's, or its overview's chords as a Toolpath."""
+        if self.view.stride == 1:
+            return self.path, self._coloring
+        first, last = self._chords
+        p = self.path
+        move_of = p.move_of[first]
+        chords = dataclasses.replace(p, start=p.start[first], end=p.end[last], move_of=move_of, kind=p.kind[first],
+                                     move_seg=np.searchsorted(move_of, np.arange(p.move_rows.size + 1)))
+        return chords, dataclasses.replace(self._coloring, values=self._coloring.values[first])
 
     def __repr__(self) -> str:
         if self.error is not None:

@@ -5,7 +5,10 @@ colours and camera (:mod:`gcodekit.view`) with matplotlib's Agg canvas
 (no display, no GPU, no thread of its own) through
 :func:`gcodekit.visualize.draw_toolpath`, for ``screenshot()`` and for the
 PNG every widget puts in its rich display so an exported notebook shows it
-offline.
+offline.  matplotlib draws about ten thousand segments a second here, so
+more than :data:`RASTER_FROM` segments are drawn as the WebGL view draws
+them, one pixel wide with a depth buffer, by :func:`raster_toolpath` in
+NumPy, and shown as an image in the same figure.
 """
 
 from __future__ import annotations
@@ -23,6 +26,10 @@ if TYPE_CHECKING:
     from ..view import Coloring, Toolpath
 
 DPI = 100
+#: Segments from which a picture's toolpath is rasterised in NumPy rather than drawn by matplotlib.
+RASTER_FROM = 20_000
+#: Segments rasterised at a time (bounds the memory of the samples along them).
+RASTER_CHUNK = 400_000
 
 
 def new_figure(size: tuple[int, int]) -> "Figure":
@@ -69,7 +76,8 @@ def toolpath_figure(path: "Toolpath", span: tuple[int, int], color: "Coloring", 
     keep = np.arange(a, b)
     if not show_travel:
         keep = keep[path.kind[keep] == 0]
-    vmin, vmax = draw_toolpath(ax, path, color, camera, keep)
+    draw = raster_toolpath if keep.size > RASTER_FROM else draw_toolpath
+    vmin, vmax = draw(ax, path, color, camera, keep)
     if current_move >= 0:
         right, up, _ = camera.axes()
         centre, _ = camera.view(*path.frame())
@@ -79,3 +87,48 @@ def toolpath_figure(path: "Toolpath", span: tuple[int, int], color: "Coloring", 
         fig.text(0.01, 0.97, title, fontsize=10, va="center")
     add_legend(fig, color, path, keep, vmin, vmax)
     return fig
+
+
+def raster_toolpath(ax, path: "Toolpath", color: "Coloring", camera: Camera,
+                    segments: np.ndarray) -> tuple[float, float]:
+    """:func:`~gcodekit.visualize.draw_toolpath`'s picture as an image: lines one pixel wide, the nearest in front.
+
+    Each segment is sampled at every pixel it crosses; a depth buffer keeps
+    the sample nearest the eye per pixel (``np.maximum.at``), in chunks of
+    :data:`RASTER_CHUNK` segments.  The Axes are framed as ``draw_toolpath``
+    frames them; returns the colour scale.
+    """
+    right, up, eye = camera.axes()
+    centre, half = camera.view(*path.frame())
+    box = ax.get_position()
+    fig_w, fig_h = ax.figure.get_size_inches()
+    width, height = max(int(round(box.width * fig_w * DPI)), 1), max(int(round(box.height * fig_h * DPI)), 1)
+    half_w = half * width / height
+    rgb, vmin, vmax = color.segment_rgb(path, segments)
+    image = np.ones((height, width, 3))
+    depth = np.full(height * width, -np.inf)
+    for c in range(0, segments.size, RASTER_CHUNK):
+        keep = segments[c:c + RASTER_CHUNK]
+        ends = [(path.start[keep] - centre), (path.end[keep] - centre)]
+        # pixel column, row (0 at the top) and nearness of each end
+        cols = [(p @ right + half_w) / (2 * half_w) * width for p in ends]
+        rows = [(half - p @ up) / (2 * half) * height for p in ends]
+        near = [p @ eye for p in ends]
+        count = np.clip(np.ceil(np.maximum(np.abs(cols[1] - cols[0]), np.abs(rows[1] - rows[0]))), 1, 4 * width) + 1
+        count = count.astype(np.int64)
+        seg = np.repeat(np.arange(keep.size), count)
+        t = (np.arange(seg.size) - np.repeat(np.cumsum(count) - count, count)) / (count - 1)[seg]
+        x = np.floor(cols[0][seg] + t * (cols[1] - cols[0])[seg]).astype(np.int64)
+        y = np.floor(rows[0][seg] + t * (rows[1] - rows[0])[seg]).astype(np.int64)
+        z = near[0][seg] + t * (near[1] - near[0])[seg]
+        inside = (x >= 0) & (x < width) & (y >= 0) & (y < height)
+        pixel, z, seg = y[inside] * width + x[inside], z[inside], seg[inside]
+        np.maximum.at(depth, pixel, z)
+        front = z >= depth[pixel]  # the nearest so far: a later chunk's nearer sample overwrites it
+        image.reshape(-1, 3)[pixel[front]] = rgb[c:c + RASTER_CHUNK][seg[front]]
+    x0, y0 = 0.0, 0.0  # the Axes' coordinates are mm from the point looked at, as draw_toolpath's
+    ax.imshow(image, extent=(x0 - half_w, x0 + half_w, y0 - half, y0 + half), interpolation="nearest",
+              aspect="auto")
+    ax.set_xlim(x0 - half_w, x0 + half_w)
+    ax.set_ylim(y0 - half, y0 + half)
+    return vmin, vmax

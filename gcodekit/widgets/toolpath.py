@@ -21,18 +21,29 @@ def load_toolpath(source, group_by: str | None = None) -> Toolpath:
     ToolpathError
         When the source cannot be read or has no motion to draw.
     """
+    return Toolpath.of(load_source(source), group_by)
+
+
+def load_source(source):
+    """An Operation or AdditivePart as given, or the Operation of a path or program text (read here).
+
+    Raises
+    ------
+    ToolpathError
+        When the source cannot be read, or is neither an Operation, an AdditivePart nor a path.
+    """
     from ..errors import GcodeError
     from ..model.operation import Operation
 
-    if not (isinstance(source, Operation) or hasattr(source, "waypoint_layer")):
-        if not isinstance(source, (str, os.PathLike)):
-            raise ToolpathError(f"cannot draw a {type(source).__name__}: give an Operation, an AdditivePart or a path")
-        if isinstance(source, str) and not source.strip():
-            raise ToolpathError("the program is empty (no text)")
-        from ..pipeline import gcode_to_operation
+    if isinstance(source, Operation) or hasattr(source, "waypoint_layer"):
+        return source
+    if not isinstance(source, (str, os.PathLike)):
+        raise ToolpathError(f"cannot draw a {type(source).__name__}: give an Operation, an AdditivePart or a path")
+    if isinstance(source, str) and not source.strip():
+        raise ToolpathError("the program is empty (no text)")
+    from ..pipeline import gcode_to_operation
 
-        try:
-            source = gcode_to_operation(source)  # a path, or the program's text
-        except (GcodeError, OSError, ValueError) as exc:
-            raise ToolpathError(str(exc)) from exc
-    return Toolpath.of(source, group_by)
+    try:
+        return gcode_to_operation(source)  # a path, or the program's text
+    except (GcodeError, OSError, ValueError) as exc:
+        raise ToolpathError(str(exc)) from exc

@@ -1,6 +1,6 @@
 """Widgets stage: VelocityPlot, commanded feed against the planner's speed.
 
-The profile (:func:`gcodekit.analysis.velocity_profile`, four corners per
+The profile (:func:`gcodekit.analysis.velocity_corners`, four corners per
 planned move) can hold half a million points; the browser gets at most a
 few thousand for the range shown: every corner when they fit, else the
 lowest and highest speed per bin (a line plot drawn at pixel density looks
@@ -17,10 +17,10 @@ import ipywidgets as widgets
 import numpy as np
 import traitlets
 
+from ..view import Toolpath, ToolpathError, move_rows, source_lines
 from .display import PictureDisplay, friendly, message_html
 from .picture import message_figure, new_figure
-from ..view import Toolpath, ToolpathError, source_lines
-from .toolpath import load_toolpath
+from .toolpath import load_source
 
 #: Bins of the envelope: about one per pixel of a notebook-wide plot.
 BINS = 1200
@@ -79,12 +79,14 @@ class VelocityPlot(PictureDisplay):
         check_choice("x", x, tuple(X_LABELS))
         self.x_name = x
         self.error: str | None = None
-        self.path: Toolpath | None = None
+        self.source = None
+        self._path: Toolpath | None = None
+        self._move_times: tuple[np.ndarray, np.ndarray] | None = None
         self._linked = None
         self.view = VelocityView(height=height, x_label=X_LABELS[x], layout=widgets.Layout(width="100%"))
         self.picked = widgets.HTML()
         try:
-            self.path = load_toolpath(op)
+            self.source = load_source(op)
             self._profile()
         except ToolpathError as exc:
             self.error = str(exc)
@@ -102,24 +104,37 @@ class VelocityPlot(PictureDisplay):
 
     # -- data ---------------------------------------------------------------------
 
-    def _profile(self) -> None:
-        from ..analysis import velocity_profile
+    @property
+    def path(self) -> Toolpath | None:
+        """The toolpath whose moves the points name: a linked viewer's, else made when first needed."""
+        if self._path is None and self.source is not None:
+            self._path = Toolpath.of(self.source)
+        return self._path
 
-        op = self.path.op
-        frame = velocity_profile(op)
-        if frame.empty:
+    def _profile(self) -> None:
+        from ..analysis import velocity_corners
+
+        op = getattr(self.source, "operation", self.source)
+        self._move_rows, _ = move_rows(op)  # the toolpath's moves (Toolpath.move_rows), or why there are none
+        self.op = op
+        corners = velocity_corners(op)
+        if corners["time"].size == 0:
             raise ToolpathError(f"{op.file}: no moves to plot")
-        self.times = frame["time"].to_numpy(float)
-        self.xs = frame[self.x_name].to_numpy(float)
-        self.planned = frame["planned"].to_numpy(float)
-        self.commanded = frame["commanded"].to_numpy(float)
-        self.lines = frame["line"].to_numpy(np.int64)
+        self.times = np.asarray(corners["time"], float)
+        self.xs = np.asarray(corners[self.x_name], float)
+        self.planned = np.asarray(corners["planned"], float)
+        self.commanded = np.asarray(corners["commanded"], float)
+        self.lines = np.asarray(corners["line"], np.int64)
         if op.plan is not None:
-            waypoint, self.corners = np.repeat(op.plan[0].waypoint, 4), 4
+            self._waypoint, self.corners = op.plan[0].waypoint, 4
         else:
-            waypoint, self.corners = np.repeat(np.flatnonzero(np.asarray(op.waypoints["motion"]) > 0), 2), 2
-        self.moves = np.clip(np.searchsorted(self.path.move_rows, waypoint), 0, len(self.path.move_rows) - 1)
-        self.ymax = float(np.nanmax(np.r_[self.planned, self.commanded, 1e-9])) * 1.05
+            self._waypoint, self.corners = np.flatnonzero(np.asarray(op.waypoints["motion"]) > 0), 2
+        self.ymax = float(np.fmax.reduce([np.fmax.reduce(self.planned), np.fmax.reduce(self.commanded), 1e-9])) * 1.05
+
+    def moves_of(self, points: np.ndarray) -> np.ndarray:
+        """The toolpath move (index of ``path.move_rows``) of each of the profile's points ``points``."""
+        rows = self._move_rows
+        return np.clip(np.searchsorted(rows, self._waypoint[np.asarray(points) // self.corners]), 0, len(rows) - 1)
 
     def points(self, x0: float, x1: float, bins: int = BINS) -> dict[str, np.ndarray]:
         """What is drawn for ``x0..x1``: every corner, or per-bin min/max when more than ``3 * bins``.
@@ -132,14 +147,14 @@ class VelocityPlot(PictureDisplay):
         x, planned = self.xs[a:b], self.planned[a:b]
         if x.size <= 3 * bins:
             return {"x": x, "lo": planned, "hi": planned, "commanded": self.commanded[a:b], "line": self.lines[a:b],
-                    "move": self.moves[a:b], "mode": "raw"}
+                    "move": self.moves_of(np.arange(a, b)), "mode": "raw"}
         edges = np.linspace(x0, x1, bins + 1)
         starts = np.unique(np.searchsorted(x, edges[:-1]))
         starts = starts[starts < x.size]
         return {"x": x[starts], "lo": np.minimum.reduceat(planned, starts),
                 "hi": np.maximum.reduceat(planned, starts),
                 "commanded": np.maximum.reduceat(self.commanded[a:b], starts),
-                "line": self.lines[a:b][starts], "move": self.moves[a:b][starts], "mode": "binned"}
+                "line": self.lines[a:b][starts], "move": self.moves_of(a + starts), "mode": "binned"}
 
     # -- what is shown ---------------------------------------------------------------
 
@@ -159,11 +174,13 @@ class VelocityPlot(PictureDisplay):
             self.view.move = np.asarray(p["move"], np.int32).tobytes()
             self.view.mode, self.view.corners = p["mode"], self.corners
             self.view.range, self.view.ymax = list(self.range), self.ymax
-            self.view.title = f"{Path(self.path.op.file).name}: {x0:.6g}-{x1:.6g} {X_LABELS[self.x_name].split(' ')[1]}"
+            self.view.title = f"{Path(self.op.file).name}: {x0:.6g}-{x1:.6g} {X_LABELS[self.x_name].split(' ')[1]}"
 
     def show_moves(self, first: int, last: int) -> None:
         """Show the moves ``first..last`` (indices of the toolpath's moves)."""
-        start, end = self.path.times()
+        if self._move_times is None:  # a slider step asks again: the toolpath's times once
+            self._move_times = self.path.times()
+        start, end = self._move_times
         t0, t1 = start[first], end[last]
         if self.x_name == "distance":
             t0, t1 = np.interp([t0, t1], self.times, self.xs)
@@ -183,6 +200,8 @@ class VelocityPlot(PictureDisplay):
         if self.error is not None or viewer.error is not None:
             return self
         self._linked = viewer
+        if viewer.path.op is self.op and self._path is None:
+            self._path = viewer.path  # one toolpath for both (a large program's takes seconds to cut)
 
         def follow(change=None):
             lo, hi = viewer.layers.value
@@ -199,7 +218,7 @@ class VelocityPlot(PictureDisplay):
         if not picked:
             return
         move, line = int(picked[0]), int(picked[1])
-        lines = source_lines(self.path.op) or []
+        lines = source_lines(self.op) or []
         text = html.escape(lines[line - 1]) if 0 < line <= len(lines) else ""
         self.picked.value = (f'<div class="gcodekit-picked" style="font:12px monospace">move {move}, line {line}: '
                              f'<b>{text}</b></div>')
@@ -239,4 +258,4 @@ class VelocityPlot(PictureDisplay):
     def __repr__(self) -> str:
         if self.error is not None:
             return f"<VelocityPlot: {self.error}>"
-        return f"<VelocityPlot {Path(self.path.op.file).name!r}: {self.x_name} {self.range[0]:.6g}-{self.range[1]:.6g}>"
+        return f"<VelocityPlot {Path(self.op.file).name!r}: {self.x_name} {self.range[0]:.6g}-{self.range[1]:.6g}>"

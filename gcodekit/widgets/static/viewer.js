@@ -1,8 +1,12 @@
 // gcodekit LayerViewer front end: the toolpath's segments drawn with WebGL.
 //
-// The segments arrive once as binary buffers (positions, values, kinds and the
-// move and group offsets); a layer or move step only changes which contiguous
-// range of them is drawn, so a step costs one draw call, not a new mesh.
+// The segments arrive once as binary buffers (positions, values, kinds, each
+// one's move and the group offsets); a layer or move step only changes which
+// contiguous range of them is drawn, so a step costs one draw call, not a new
+// mesh.  A large program arrives as an overview (chords through every
+// stride-th point of each run, stride > 1): the layers below the top one are
+// drawn from it, and the top layer from its own segments, asked of the kernel
+// when it is first shown and kept (a few dozen layers at most).
 // The camera is orthographic with Z up, as in gcodekit/widgets/picture.py:
 // azimuth turns about Z, elevation lifts the eye from the XY plane.
 
@@ -138,20 +142,64 @@ function render({ model, el }) {
     u[name] = loc(name);
   }
   const buffers = { pos: gl.createBuffer(), val: gl.createBuffer(), kind: gl.createBuffer() };
+  // layers' own segments, by group: their buffers, values, kinds and each move's first segment
+  const details = new Map();
+  const asked = new Set();
+  const KEEP = 32;
   const texture = gl.createTexture();
   // On a software renderer every segment costs: pictures of the range drawn so far are kept at
   // checkpoints, so a step redraws at most one checkpoint's worth of segments plus the top layer.
   const cache = software && typeof WebGL2RenderingContext !== "undefined" && gl instanceof WebGL2RenderingContext
     ? { key: "", work: null, points: [], width: 0, height: 0 } : null;
-  const state = { nSeg: 0, values: new Float32Array(0), kinds: new Uint8Array(0), moveSeg: new Int32Array(1),
-    groupMove: new Int32Array(1), moveLimit: null, frame: 0, pending: false, ncat: 0, width: 400, drawn: "",
-    version: 0 };
+  const state = { nSeg: 0, values: new Float32Array(0), kinds: new Uint8Array(0), segMove: new Int32Array(0),
+    groupSeg: new Int32Array(1), groupMove: new Int32Array(1), moveLimit: null, frame: 0, pending: false, ncat: 0,
+    width: 400, drawn: "", version: 0 };
 
   function attribute(name, buffer, size) {
     const index = gl.getAttribLocation(program, name);
     gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
     gl.enableVertexAttribArray(index);
     gl.vertexAttribPointer(index, size, gl.FLOAT, false, 0, 0);
+  }
+
+  function use(set) { // draw from the overview's buffers or a layer's own
+    attribute("a_pos", set.pos, 3);
+    attribute("a_kind", set.kind, 1);
+    attribute("a_val", set.val, 1);
+  }
+
+  function dropDetails() {
+    for (const d of details.values()) { gl.deleteBuffer(d.pos); gl.deleteBuffer(d.kind); gl.deleteBuffer(d.val); }
+    details.clear();
+    asked.clear();
+  }
+
+  function ask(group) {
+    const groups = state.groupMove.length - 1;
+    if (model.get("stride") === 1 || group < 0 || group >= groups || details.has(group) || asked.has(group)) return;
+    asked.add(group);
+    model.send({ detail: group });
+  }
+
+  function onDetail(msg, views) {
+    if (!msg || msg.detail === undefined || msg.version !== model.get("color_version")) return;
+    asked.delete(msg.detail);
+    const make = (data) => { const b = gl.createBuffer(); gl.bindBuffer(gl.ARRAY_BUFFER, b);
+      gl.bufferData(gl.ARRAY_BUFFER, data, gl.STATIC_DRAW); return b; };
+    const values = typed(views[2], Float32Array), kinds = typed(views[1], Uint8Array);
+    details.set(msg.detail, { pos: make(typed(views[0], Float32Array)), kind: make(perVertex(kinds)),
+      val: make(perVertex(values)), values, kinds, moveSeg: typed(views[3], Int32Array) });
+    while (details.size > KEEP) { // the layer shown longest ago goes
+      const [group, d] = details.entries().next().value;
+      gl.deleteBuffer(d.pos); gl.deleteBuffer(d.kind); gl.deleteBuffer(d.val);
+      details.delete(group);
+    }
+    schedule();
+  }
+
+  function upper(array, lo, hi, value) { // first index in [lo, hi) whose value exceeds value
+    while (lo < hi) { const mid = (lo + hi) >> 1; if (array[mid] <= value) lo = mid + 1; else hi = mid; }
+    return lo;
   }
 
   function perVertex(perSegment) {
@@ -164,14 +212,13 @@ function render({ model, el }) {
     const pos = typed(model.get("positions"), Float32Array);
     state.nSeg = pos.length / 6;
     state.kinds = typed(model.get("kinds"), Uint8Array);
-    state.moveSeg = typed(model.get("move_seg"), Int32Array);
+    state.segMove = typed(model.get("seg_move"), Int32Array);
+    state.groupSeg = typed(model.get("group_seg"), Int32Array);
     state.groupMove = typed(model.get("group_move"), Int32Array);
     gl.bindBuffer(gl.ARRAY_BUFFER, buffers.pos);
     gl.bufferData(gl.ARRAY_BUFFER, pos, gl.STATIC_DRAW);
     gl.bindBuffer(gl.ARRAY_BUFFER, buffers.kind);
     gl.bufferData(gl.ARRAY_BUFFER, perVertex(state.kinds), gl.STATIC_DRAW);
-    attribute("a_pos", buffers.pos, 3);
-    attribute("a_kind", buffers.kind, 1);
     state.version += 1;
   }
 
@@ -179,7 +226,7 @@ function render({ model, el }) {
     state.values = typed(model.get("values"), Float32Array);
     gl.bindBuffer(gl.ARRAY_BUFFER, buffers.val);
     gl.bufferData(gl.ARRAY_BUFFER, perVertex(state.values), gl.STATIC_DRAW);
-    attribute("a_val", buffers.val, 1);
+    dropDetails(); // the layers' own values are another colouring's
     const table = typed(model.get("palette"), Uint8Array);
     const n = Math.max(table.length / 3, 1);
     const rgba = new Uint8Array(n * 4);
@@ -204,11 +251,21 @@ function render({ model, el }) {
     let [lo, hi] = model.get("layers");
     lo = Math.max(0, Math.min(lo, groups - 1));
     hi = Math.max(lo, Math.min(hi, groups - 1));
-    const gm = state.groupMove, ms = state.moveSeg;
+    const gm = state.groupMove, gs = state.groupSeg;
     const count = gm[hi + 1] - gm[hi];
     const shown = state.moveLimit === null ? count : Math.min(Math.max(state.moveLimit, 0) + 1, count);
     const current = count > 0 ? gm[hi] + shown - 1 : -1;
-    return { lo, hi, a: ms[gm[lo]], b: ms[gm[hi] + shown], current, shown, count };
+    // the chords of the top group up to the current move (those that start by then)
+    const cut = upper(state.segMove, gs[hi], gs[hi + 1], current);
+    const detail = model.get("stride") === 1 ? null : details.get(hi) || null;
+    if (detail) { details.delete(hi); details.set(hi, detail); } // kept the longest: the layers shown last
+    return { lo, hi, a: gs[lo], base: gs[hi], b: cut, current, shown, count, detail };
+  }
+
+  // the top group: [values, kinds, first, end] of what is drawn of it
+  function top(s) {
+    if (s.detail) return [s.detail.values, s.detail.kinds, 0, s.detail.moveSeg[s.shown]];
+    return [state.values, state.kinds, s.base, s.b];
   }
 
   function hex(r, g, b) {
@@ -266,7 +323,8 @@ function render({ model, el }) {
     const ratio = window.devicePixelRatio || 1;
     // the size comes from the ResizeObserver: reading it here would force a layout of the whole page
     const width = Math.round(Math.max(state.width, 50) * ratio), height = Math.round(model.get("height") * ratio);
-    const key = JSON.stringify([s, camera, width, height, model.get("show_travel"), state.version]);
+    const key = JSON.stringify([s && [s.lo, s.hi, s.a, s.b, s.shown, s.detail !== null], camera, width, height,
+      model.get("show_travel"), state.version]);
     if (key === state.drawn) return; // the same picture (a control echoed back by the kernel)
     state.drawn = key;
     if (canvas.width !== width || canvas.height !== height) {
@@ -283,12 +341,14 @@ function render({ model, el }) {
     let vmin = Infinity, vmax = -Infinity;
     const cats = state.ncat;
     const present = new Uint8Array(Math.max(cats, 1));
-    const v = state.values, k = state.kinds;
-    for (let i = s.a; i < s.b; i++) {
-      if (k[i] !== 0) continue;
-      const x = v[i];
-      if (cats) present[x] = 1;
-      else if (Number.isFinite(x)) { if (x < vmin) vmin = x; if (x > vmax) vmax = x; }
+    const [tv, tk, t0, t1] = top(s);
+    for (const [v, k, i0, i1] of [[state.values, state.kinds, s.a, s.base], [tv, tk, t0, t1]]) {
+      for (let i = i0; i < i1; i++) {
+        if (k[i] !== 0) continue;
+        const x = v[i];
+        if (cats) present[x] = 1;
+        else if (Number.isFinite(x)) { if (x < vmin) vmin = x; if (x > vmax) vmax = x; }
+      }
     }
     if (!(vmin <= vmax)) { vmin = 0; vmax = 1; }
     gl.uniformMatrix4fv(u.u_mvp, false, matrix(camera, model.get("radius"), canvas.width / canvas.height));
@@ -302,14 +362,25 @@ function render({ model, el }) {
     gl.uniform1i(u.u_cmap, 0);
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, texture);
+    use(buffers);
     if (cache) {
       drawCached(s, JSON.stringify([s.lo, camera, canvas.width, canvas.height, model.get("show_travel"), state.version,
         vmin, vmax]));
-    } else if (s.b > s.a) {
-      gl.drawArrays(gl.LINES, 2 * s.a, 2 * (s.b - s.a));
+    } else if (s.base > s.a) {
+      gl.drawArrays(gl.LINES, 2 * s.a, 2 * (s.base - s.a));
     }
-    if (s.current >= 0) { // the current move in red, its end as a dot
-      const m0 = state.moveSeg[s.current], m1 = state.moveSeg[s.current + 1];
+    drawTop(s);
+    if (cache) copy(cache.work.fb, null, gl.COLOR_BUFFER_BIT);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    // the current move in red, its end as a dot (from the overview: when a chord of its own starts there)
+    let m0 = -1, m1 = -1;
+    if (s.detail && s.current >= 0) {
+      use(s.detail);
+      m0 = s.detail.moveSeg[s.shown - 1]; m1 = s.detail.moveSeg[s.shown];
+    } else if (s.current >= 0 && s.b > s.base && state.segMove[s.b - 1] === s.current) {
+      m0 = upper(state.segMove, s.base, s.b, s.current - 1); m1 = s.b;
+    }
+    if (m1 > m0 && m0 >= 0) {
       gl.uniform1f(u.u_solid, 1);
       gl.uniform4f(u.u_color, 0.89, 0.0, 0.17, 1.0);
       gl.disable(gl.DEPTH_TEST);
@@ -319,10 +390,27 @@ function render({ model, el }) {
     drawLegend(s, vmin, vmax, present);
     const labels = model.get("group_labels");
     const groups = s.lo === s.hi ? labels[s.lo] : `${labels[s.lo]} to ${labels[s.hi]}`;
+    const full = model.get("stride") === 1 || s.detail !== null;
+    const drawn = s.base - s.a + t1 - t0;
     state.frame += 1;
-    status.textContent = `${groups} · move ${s.shown} of ${s.count} · ${s.b - s.a} segments`;
+    status.textContent = `${groups} · move ${s.shown} of ${s.count} · ${drawn} segments` +
+      (model.get("stride") === 1 ? "" : full ? " (layers below: overview)" : " (overview)");
+    status.dataset.detail = full ? "full" : "overview";
     status.dataset.frame = String(state.frame);
-    status.dataset.segments = String(s.b - s.a);
+    status.dataset.segments = String(drawn);
+    if (!full) ask(s.hi);
+    else { ask(s.hi - 1); ask(s.hi + 1); } // the next steps' layers, while the view is idle
+  }
+
+  function drawTop(s) { // into the framebuffer bound: the top group, its own segments or the overview's chords
+    if (s.detail) {
+      const n = s.detail.moveSeg[s.shown];
+      use(s.detail);
+      if (n > 0) gl.drawArrays(gl.LINES, 0, 2 * n);
+      use(buffers);
+    } else if (s.b > s.base) {
+      gl.drawArrays(gl.LINES, 2 * s.base, 2 * (s.b - s.base));
+    }
   }
 
   function target(w, h) {
@@ -358,7 +446,7 @@ function render({ model, el }) {
     }
     // at most 24 checkpoints (memory: two buffers of the canvas's size each), 2000 segments apart or more
     const step = Math.max(2000, Math.ceil(state.nSeg / 24));
-    const base = state.moveSeg[state.groupMove[s.hi]]; // where the top group starts
+    const base = s.base; // where the top group starts
     const both = gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT;
     let j = Math.min(Math.floor((base - s.a) / step), cache.points.length) - 1;
     while (j >= 0 && !cache.points[j]) j--;
@@ -382,9 +470,7 @@ function render({ model, el }) {
       }
       pos = stop;
     }
-    if (s.b > base) gl.drawArrays(gl.LINES, 2 * base, 2 * (s.b - base));
-    copy(cache.work.fb, null, gl.COLOR_BUFFER_BIT);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, cache.work.fb); // the top group is drawn over it by the caller
   }
 
   function schedule() {
@@ -469,6 +555,7 @@ function render({ model, el }) {
     if (group === model.get("layers")[1]) { state.moveLimit = move; schedule(); }
   };
   model.on("change:positions", onGeometry);
+  model.on("msg:custom", onDetail);
   model.on("change:values change:palette change:categories change:title", onColors);
   model.on("change:layers", onLayers);
   model.on("change:top_move", onMove);
@@ -489,6 +576,8 @@ function render({ model, el }) {
     if (cache) { cache.points.forEach(release); release(cache.work); }
     resize.disconnect();
     model.off("change:positions", onGeometry);
+    model.off("msg:custom", onDetail);
+    dropDetails();
     model.off("change:values change:palette change:categories change:title", onColors);
     model.off("change:layers", onLayers);
     model.off("change:top_move", onMove);
