@@ -50,19 +50,28 @@ def test_plan_rows_give_the_time_ratio_and_bind_only_on_the_cylinder(run_all):
 
 
 def test_scale_rows_compare_each_tool_with_the_loop_on_its_file(run_all):
-    # bench_scale.py is written on another branch; its documented keys: tool, file, seconds, peak_mb,
-    # bytes_per_line, lines (these figures are made up for the test)
-    rows = [{"tool": "50-line loop", "file": "plate.gz", "seconds": 10.0, "peak_mb": 20, "bytes_per_line": 7,
+    # the targets bind on plate150; these figures are made up for the test
+    plate = "plate150_marlin2.gcode.gz"
+    rows = [{"tool": "python_loop", "file": plate, "seconds": 10.0, "peak_mb": 20, "bytes_per_line": 7,
              "lines": 3_000_000},
-            {"tool": "gcodekit marlin", "file": "plate.gz", "seconds": 4.0, "peak_mb": 400, "bytes_per_line": 140,
+            {"tool": "gcodekit marlin", "file": plate, "seconds": 4.0, "peak_mb": 400, "bytes_per_line": 140,
              "lines": 3_000_000},
-            {"tool": "gcodekit klipper", "file": "plate.gz", "seconds": 6.0, "peak_mb": 420, "bytes_per_line": 140,
+            {"tool": "gcodekit klipper", "file": plate, "seconds": 6.0, "peak_mb": 420, "bytes_per_line": 140,
              "lines": 3_000_000}]
     loop, marlin, klipper = run_all.scale_rows({"rows": rows})
     assert loop["ratio"] is None and loop["pass"] is None
     assert marlin["ratio"] == pytest.approx(0.4) and marlin["pass"] is True
     assert klipper["ratio"] == pytest.approx(0.6) and klipper["pass"] is False
     assert run_all.scale_rows(rows)[1]["ratio"] == pytest.approx(0.4)  # a plain list too
+
+
+def test_a_quick_scale_run_shows_its_ratios_without_binding(run_all):
+    # bench_scale.py --quick's real record (the cylinder): ratios to the loop, no pass or fail
+    loop, *ours = run_all.scale_rows(record("scale"))
+    assert loop["tool"] == "python_loop" and loop["ratio"] is None
+    for r in ours:
+        assert r["ratio"] == pytest.approx(r["seconds"] / loop["seconds"])
+        assert r["pass"] is None and r["note"].endswith("target binds on plate150")
 
 
 def test_cut_and_additive_rows_have_no_peer(run_all):
