@@ -204,10 +204,12 @@ def velocity(op: "Operation", bins: int = 1500, window_s: float = 20.0) -> "Figu
     visible; the window (``window_s`` around the middle of the program)
     shows the planner's trapezoids.
     """
-    v = op.velocity_profile()
-    if v.empty:
+    from ..analysis import velocity_corners  # arrays: a DataFrame of a 3 M-line print's corners costs seconds
+
+    v = velocity_corners(op)
+    if v["time"].size == 0:
         return None
-    t, planned, commanded = (v[c].to_numpy(float) for c in ("time", "planned", "commanded"))
+    t, planned, commanded = (np.asarray(v[c], float) for c in ("time", "planned", "commanded"))
     fig = _figure(4.4, left=0.08, right=0.98, bottom=0.1, top=0.94, hspace=0.42)
     top, bottom = fig.subplots(2, 1)
     # mean speed per bin from the running integrals: planned distance, and commanded speed times time
@@ -215,7 +217,7 @@ def velocity(op: "Operation", bins: int = 1500, window_s: float = 20.0) -> "Figu
     dt = np.diff(t)
     commanded_d = np.r_[0.0, np.cumsum(commanded[:-1] * dt)]
     for running, label, colour in ((commanded_d, "commanded", "#c44e52"),
-                                   (v["distance"].to_numpy(float), "planned", "#3b6ea8")):
+                                   (np.asarray(v["distance"], float), "planned", "#3b6ea8")):
         mean = np.diff(np.interp(edges, t, running)) / np.diff(edges)
         top.plot((edges[:-1] + edges[1:]) / 2, mean, color=colour, lw=0.8, label=label)
     top.set_title(f"Mean speed over the whole program ({bins} time bins)", fontsize=10)
