@@ -141,6 +141,25 @@ def shot(locator):
     return np.asarray(Image.open(io.BytesIO(locator.screenshot())).convert("RGB"), dtype=int)
 
 
+def trame_view(page, name: str):
+    """The output area and picture frame of a trame view (``gcodekit-<name>-view``), once its canvas exists."""
+    area = page.locator(f".jp-OutputArea-child:has(.gcodekit-{name}-view)")
+    frame = area.locator(f"iframe.gcodekit-{name}-frame")
+    frame.wait_for(timeout=60_000)
+    page.frame_locator(f"iframe.gcodekit-{name}-frame").locator("canvas").first.wait_for(timeout=60_000)
+    return area, frame
+
+
+def shot_when(frame, ready, timeout_s=60.0):
+    """Screenshots of the view until ``ready(picture)`` holds or the time is up; the last one (the caller asserts)."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        picture = shot(frame)
+        if ready(picture) or time.monotonic() > deadline:
+            return picture
+        time.sleep(0.5)
+
+
 def wait_for_picture(frame, previous, timeout_s=120.0):
     """Poll the view until its picture differs from ``previous``; the new picture and the seconds waited."""
     start = time.perf_counter()

@@ -21,7 +21,7 @@ pytest.importorskip("playwright")
 pytest.importorskip("trame_pyvista")
 
 from jupyter_browser import (browser_page, chromium_path, drag_turns, jupyter_lab, open_and_run, settled,  # noqa: E402
-                             shot, wait_for_picture)
+                             shot_when, trame_view, wait_for_picture)
 
 ROOT = Path(__file__).resolve().parents[1]
 PROGRAM = "cube20_prusaslicer_marlin.gcode"
@@ -69,18 +69,9 @@ def test_beads_show_turn_and_follow_the_slider(lab):
     from gcodekit.additive import AdditivePart, bead_tubes
 
     page, root = lab
-    area = page.locator(".jp-OutputArea-child:has(.gcodekit-bead-view)")
-    frame = area.locator("iframe.gcodekit-bead-frame")
-    frame.wait_for(timeout=60_000)
-    canvas = page.frame_locator("iframe.gcodekit-bead-frame").locator("canvas").first
-    canvas.wait_for(timeout=60_000)
+    area, frame = trame_view(page, "bead")
     # every depositing move laid: the cube's walls, their outer perimeters red, drawn in the browser
-    deadline = time.monotonic() + 60
-    while True:
-        first = shot(frame)
-        if ink(first).mean() > 0.08 and red(first).mean() > 0.03 or time.monotonic() > deadline:
-            break
-        time.sleep(0.5)
+    first = shot_when(frame, lambda picture: ink(picture).mean() > 0.08 and red(picture).mean() > 0.03)
     assert ink(first).mean() > 0.08, "the beads do not show"
     assert red(first).mean() > 0.03, "the external perimeters' colour does not show"
     # shaded, not flat: the red walls take many tones

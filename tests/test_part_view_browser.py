@@ -19,7 +19,8 @@ pytest.importorskip("jupyterlab")
 pytest.importorskip("playwright")
 pytest.importorskip("trame_pyvista")
 
-from jupyter_browser import browser_page, chromium_path, jupyter_lab, open_and_run, shot, wait_for_picture  # noqa: E402
+from jupyter_browser import (browser_page, chromium_path, jupyter_lab, open_and_run, shot_when, trame_view,  # noqa: E402
+                             wait_for_picture)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -36,6 +37,10 @@ def _notebook(path: Path) -> None:
     path.write_text(json.dumps({"cells": cells, "metadata": {"kernelspec": {"name": "python3",
                                                                             "display_name": "Python 3"}},
                                 "nbformat": 4, "nbformat_minor": 5}))
+
+
+def ink(image) -> np.ndarray:
+    return image.min(axis=2) < 235
 
 
 def cut_colour(image) -> np.ndarray:
@@ -61,20 +66,10 @@ def lab(tmp_path_factory):
 
 def test_part_shows_turns_and_follows_the_slider(lab):
     page, root = lab
-    area = page.locator(".jp-OutputArea-child:has(.gcodekit-part-view)")
-    frame = area.locator("iframe.gcodekit-part-frame")
-    frame.wait_for(timeout=60_000)
-    canvas = page.frame_locator("iframe.gcodekit-part-frame").locator("canvas").first
-    canvas.wait_for(timeout=60_000)
+    area, frame = trame_view(page, "part")
     # the whole program cut: a plate with cuts in it, drawn in the browser
-    deadline = time.monotonic() + 60
-    while True:
-        first = shot(frame)
-        ink = first.min(axis=2) < 235
-        if ink.mean() > 0.05 and cut_colour(first).mean() > 0.005 or time.monotonic() > deadline:
-            break
-        time.sleep(0.5)
-    assert ink.mean() > 0.05, "the part does not show"
+    first = shot_when(frame, lambda picture: ink(picture).mean() > 0.05 and cut_colour(picture).mean() > 0.005)
+    assert ink(first).mean() > 0.05, "the part does not show"
     assert cut_colour(first).mean() > 0.005, "no cut surfaces show"
 
     # a drag turns it (in the browser: the kernel is not asked)
