@@ -20,11 +20,12 @@ import re
 
 import numpy as np
 
-from ..errors import Diagnostics
+from ..errors import Diagnostics, MissingDependencyError, check_choice
 from ..read import Blocks
 from ..syntax import Flavor, load_flavor
 from ..syntax.flavor import code_label
 from .commands import Kind
+from . import rows_kernel
 from .lathe_profiles import lathe_profiles
 from .split import AXIS_CONSUMERS, AXIS_LETTERS, Part, code_name, split_block
 from .word_checks import MODAL_USERS, WORD_USERS, stray_letters, stray_word_message, user_code_keys
@@ -58,12 +59,20 @@ class GcodeParser:
     flavor : Flavor or str
     diagnostics : Diagnostics, default: a new lenient collector
         Receives unknown codes, repeated words and moves without a motion mode.
+    engine : {"auto", "numba", "numpy"}, default: "auto"
+        Who builds the rows of one-code blocks: NumPy passes (the
+        reference), the compiled loop of :mod:`.rows_kernel` (Numba must be
+        installed), or "auto": the compiled loop for large chunks once Numba
+        is loaded.  Both give the same rows.
 
     The parser keeps the modal motion mode between calls, so a long program
     can be parsed chunk by chunk.
     """
 
-    def __init__(self, flavor: Flavor | str, diagnostics: Diagnostics | None = None):
+    def __init__(self, flavor: Flavor | str, diagnostics: Diagnostics | None = None, *, engine: str = "auto"):
+        self.engine = check_choice("engine", engine, ("auto", "numba", "numpy"))
+        if engine == "numba" and rows_kernel.compiled() is None:
+            raise MissingDependencyError("the compiled parser needs Numba: pip install 'gcodekit[fast]'")
         self.flavor = load_flavor(flavor) if isinstance(flavor, str) else flavor
         self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
         self.motion = MOTION_OF_NAME.get(self.flavor.initial_motion, MOTION_NONE)
@@ -177,8 +186,32 @@ class GcodeParser:
         return first_word < first_code
 
     def _simple_rows(self, blocks: Blocks, simple: np.ndarray, is_code, is_param) -> dict:
-        wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
         rows_blocks = np.flatnonzero(simple)
+        if rows_kernel.use_compiled(self.engine, len(blocks)):
+            letter, number, present, table, repeats = rows_kernel.simple_rows_compiled(
+                blocks.word_block, blocks.word_letter, blocks.word_value, rows_blocks, len(blocks), self._n_letter,
+                _LETTER_ROW)
+        else:
+            letter, number, present, table, repeats = self._simple_rows_numpy(blocks, rows_blocks, simple, is_code,
+                                                                              is_param)
+        for row, j, word in repeats.tolist():
+            line = int(blocks.block_line[blocks.word_block[word]])
+            self.diagnostics.report(line, int(blocks.word_col[word]),
+                                    f"more than one {PARAM_LETTERS[present[j]]} word in the block; the first is used",
+                                    severity="error" if self._modal else "warning")
+        params = {PARAM_LETTERS[k]: table[j].copy() for j, k in enumerate(present.tolist())}
+        return {
+            "block": rows_blocks,
+            "sub": np.zeros(rows_blocks.size, np.int32),
+            "letter": letter,
+            "number": number,
+            "params": params,
+        }
+
+    @staticmethod
+    def _simple_rows_numpy(blocks: Blocks, rows_blocks: np.ndarray, simple: np.ndarray, is_code, is_param):
+        """The rows of one-code blocks by NumPy passes (the reference of :mod:`.rows_kernel`)."""
+        wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
         n = rows_blocks.size
         row_of_block = np.full(len(blocks), -1, np.int64)
         row_of_block[rows_blocks] = np.arange(n)
@@ -207,33 +240,7 @@ class GcodeParser:
         pslot = slot[pletter]
         table = np.full((present.size, n), np.nan)
         table[pslot, prow] = wv[pw]
-        self._first_of_repeats(blocks, table, pw, prow, pslot, present, n)
-        params = {PARAM_LETTERS[k]: table[j].copy() for j, k in enumerate(present.tolist())}
-        return {
-            "block": rows_blocks,
-            "sub": np.zeros(n, np.int32),
-            "letter": letter,
-            "number": number,
-            "params": params,
-        }
-
-    def _first_of_repeats(self, blocks: Blocks, table, pw, prow, pslot, present, n_rows) -> None:
-        """A letter given twice in a block: report it and keep the first value.
-
-        ``pslot`` is each word's row of ``table``, whose rows are the letters ``present``.
-        """
-        if not pw.size:
-            return
-        width = present.size
-        counts = np.bincount(prow * width + pslot, minlength=n_rows * width)
-        for key in np.flatnonzero(counts > 1).tolist():
-            row, j = divmod(key, width)
-            words = pw[(prow == row) & (pslot == j)]
-            table[j, row] = blocks.word_value[words[0]]
-            line = int(blocks.block_line[blocks.word_block[words[1]]])
-            self.diagnostics.report(line, int(blocks.word_col[words[1]]),
-                                    f"more than one {PARAM_LETTERS[present[j]]} word in the block; the first is used",
-                                    severity="error" if self._modal else "warning")
+        return letter, number, present, table, _first_of_repeats(wv, table, pw, prow, pslot, present.size, n)
 
     # -- compound blocks ------------------------------------------------------
 
@@ -452,6 +459,25 @@ class GcodeParser:
             else:  # firmware add codes freely (M900, M620, ...): say once, quietly, that it does nothing here
                 self.diagnostics.report(line, 1, f"{code} has no meaning in gcodekit's {self.flavor.name} flavor; "
                                         "kept as a command without effect on the path", severity="info")
+
+
+def _first_of_repeats(word_value: np.ndarray, table: np.ndarray, pw, prow, pslot, width: int,
+                      n_rows: int) -> np.ndarray:
+    """A letter given twice in a block: keep the first value in ``table``.
+
+    ``pslot`` is each parameter word's row of ``table``.  Returns the
+    repeats as (row, table row, second word), for the diagnostics.
+    """
+    if not pw.size:
+        return np.empty((0, 3), np.int64)
+    counts = np.bincount(prow * width + pslot, minlength=n_rows * width)
+    found = []
+    for key in np.flatnonzero(counts > 1).tolist():
+        row, j = divmod(key, width)
+        words = pw[(prow == row) & (pslot == j)]
+        table[j, row] = word_value[words[0]]
+        found.append((row, j, int(words[1])))
+    return np.array(found, np.int64).reshape(-1, 3)
 
 
 def _forward_fill_modes(sets: np.ndarray, initial: int) -> np.ndarray:
