@@ -22,6 +22,7 @@ import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence
 
@@ -30,6 +31,10 @@ from ..limits import MAX_ITERATIONS, MAX_MOTIONS
 
 if TYPE_CHECKING:
     import multiprocessing.context
+
+#: The pictures a report draws in a forked child (:mod:`.forked`): the toolpath views and the speed plot,
+#: about two thirds of the drawing's CPU time, as the numbers (pandas imported) are left here
+CHILD_FIGURES = ("iso", "top", "thumbnails", "velocity")
 
 
 @dataclass(frozen=True)
@@ -95,7 +100,8 @@ def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: st
     its row an ``error``; this function does not raise for a bad program.
     """
     from .build import key_figures, report_data
-    from .figures import report_figures
+    from .figures import FIGURES, load_drawing_modules, report_figures
+    from .forked import Forked
     from .html import program_page
     from ..pipeline import gcode_to_operation
 
@@ -109,8 +115,13 @@ def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: st
         op = gcode_to_operation(path, options.machine, machine_config=options.machine_config,
                                 mode="strict" if options.strict else "lenient", max_motions=options.max_motions,
                                 max_iterations=options.max_iterations)
+        # the pictures of the operation alone drawn in a forked child (one core more) while this process
+        # computes the numbers and draws the rest; the child starts with matplotlib already imported
+        load_drawing_modules()
+        drawn_aside = Forked(partial(report_figures, op, None, CHILD_FIGURES))
         data = report_data(op)
-        html_path.write_text(program_page(data, report_figures(op, data)), encoding="utf-8")
+        figures = report_figures(op, data, [f for f in FIGURES if f not in CHILD_FIGURES])
+        html_path.write_text(program_page(data, {**figures, **drawn_aside.result()}), encoding="utf-8")
         row.update(key_figures(data))
     except Exception as exc:  # noqa: BLE001 -- any failure of one program becomes its error page
         return _failed(row, html_path, exc)
@@ -188,6 +199,9 @@ def write_reports(paths: Sequence[str | os.PathLike], out_dir: str | os.PathLike
 
     from .html import index_page
 
+    class Bar(tqdm):
+        monitor_interval = 0  # no monitor thread: with one, a report could not fork (see .forked)
+
     out = Path(out_dir)
     names = output_names(paths)
     existing = [f for f in planned_outputs(names, options) if (out / f).exists()]
@@ -207,7 +221,7 @@ def write_reports(paths: Sequence[str | os.PathLike], out_dir: str | os.PathLike
     jobs.sort(key=lambda j: os.path.getsize(j[0]) if os.path.isfile(j[0]) else 0, reverse=True)
     rows: dict[str, dict[str, Any]] = {}
     with _running(jobs, workers, dask) as results, \
-            tqdm(total=len(jobs), unit="program", disable=not progress, desc="reports") as bar:
+            Bar(total=len(jobs), unit="program", disable=not progress, desc="reports") as bar:
         for job, row in results:
             if print_here and "time_s" in row:  # key figures: a report page, not an error page
                 _print_pdf(row, out)

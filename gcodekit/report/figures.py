@@ -16,7 +16,7 @@ from __future__ import annotations
 import base64
 import io
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Collection
 
 import numpy as np
 
@@ -31,6 +31,8 @@ if TYPE_CHECKING:
 THUMBNAILS = 12
 #: The pictures of a report page.
 FIGURES = ("iso", "top", "layer_times", "thumbnails", "velocity", "breakdown", "part")
+#: Those drawn from the operation alone, before its numbers are computed.
+OP_FIGURES = ("iso", "top", "thumbnails", "velocity")
 DPI = 100
 WIDTH_IN = 8.0
 
@@ -268,25 +270,50 @@ def data_uri(fig: "Figure") -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
-def report_figures(op: "Operation", data: dict[str, Any]) -> dict[str, str]:
-    """Every picture of a report as a ``data:`` URI, keyed by the names in :data:`FIGURES` (None when absent)."""
+def report_figures(op: "Operation", data: dict[str, Any] | None,
+                   only: Collection[str] = FIGURES) -> dict[str, str | None]:
+    """The pictures ``only`` of a report as ``data:`` URIs, keyed by their names in :data:`FIGURES` (None
+    when absent).
+
+    ``data`` (from :func:`~gcodekit.report.build.report_data`) is needed for
+    the pictures not in :data:`OP_FIGURES`; with it None, ``only`` names
+    some of those.
+    """
+    load_drawing_modules()
+    drawing = toolpath_drawing(op) if {"iso", "top", "thumbnails"} & set(only) else None
+    drawn = drawing is not None and drawing.segments.size > 0
+    figures: dict[str, Any] = dict.fromkeys(only)
+    if drawn and "iso" in only:
+        figures["iso"] = toolpath_iso(drawing)
+    if drawn and "top" in only:
+        figures["top"] = toolpath_top(drawing)
+    if drawn and "thumbnails" in only and op.process == "additive" and np.any(op.layers >= 0):  # data["layers"]
+        figures["thumbnails"] = layer_thumbnails(drawing)
+    if "velocity" in only:
+        figures["velocity"] = velocity(op)
+    if "layer_times" in only and data["layers"]:
+        figures["layer_times"] = layer_times(data["layers"], data.get("slicer_layers") or [])
+    if "breakdown" in only:
+        figures["breakdown"] = breakdown_chart(data["breakdown"])
+    uris = {name: None if fig is None else data_uri(fig) for name, fig in figures.items()}
+    if "part" in only and data.get("cut"):
+        uris["part"] = png_uri(data["cut"]["result"].picture(window_size=(1000, 700)))
+    return uris
+
+
+def load_drawing_modules() -> None:
+    """Import what drawing the pictures needs (matplotlib off-screen, PIL's PNG writer): once, before a
+    fork, rather than in both processes."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)  # off-screen even when a display is set
-    drawing = toolpath_drawing(op)
-    figures: dict[str, Any] = dict.fromkeys(FIGURES)
-    if drawing is not None and drawing.segments.size:
-        figures["iso"] = toolpath_iso(drawing)
-        figures["top"] = toolpath_top(drawing)
-    if data["layers"]:
-        figures["layer_times"] = layer_times(data["layers"], data.get("slicer_layers") or [])
-        figures["thumbnails"] = layer_thumbnails(drawing) if drawing is not None and drawing.segments.size else None
-    figures["velocity"] = velocity(op)
-    figures["breakdown"] = breakdown_chart(data["breakdown"])
-    uris = {name: None if fig is None else data_uri(fig) for name, fig in figures.items()}
-    if data.get("cut"):
-        uris["part"] = png_uri(data["cut"]["result"].picture(window_size=(1000, 700)))
-    return uris
+    import matplotlib.collections  # noqa: F401
+    import matplotlib.figure  # noqa: F401
+    from PIL import Image
+
+    from .. import analysis, visualize  # noqa: F401
+
+    Image.preinit()
 
 
 def png_uri(image: np.ndarray) -> str:
