@@ -141,13 +141,28 @@ def speed_factor(op: "EmulatedProgram") -> np.ndarray | None:
     return np.where(k >= 0, values[np.maximum(k, 0)], 1.0)
 
 
+def searchsorted_many(a: np.ndarray, v: np.ndarray, side: str = "left") -> np.ndarray:
+    """``np.searchsorted(a, v, side)``, merged in one pass when ``v`` is sorted and much longer than ``a``.
+
+    A program has a few thousand setting commands and millions of moves in
+    order: placing each move among the commands jumps about memory, while
+    placing the commands among the moves and counting them up is linear.
+    ``a[j] < v[i]`` (``side="left"``) holds exactly for ``i`` at or past
+    ``v``'s right insertion point of ``a[j]``; likewise ``<=`` for the left one.
+    """
+    if 8 * a.size > v.size or not (v.size < 2 or bool(np.all(v[1:] >= v[:-1]))):
+        return np.searchsorted(a, v, side=side)
+    at = np.searchsorted(v, a, side="right" if side == "left" else "left")
+    return np.cumsum(np.bincount(at, minlength=v.size + 1)[:v.size])
+
+
 def in_force(moves: PlannerMoves, rows: np.ndarray, values: np.ndarray, initial: float) -> np.ndarray:
     """Per move, the last value set by a command row before the move's row."""
     if rows.size == 0 or len(moves) == 0 or rows[0] >= moves.row[-1]:
         return np.full(len(moves), initial, dtype=float)
     if rows[-1] < moves.row[0]:  # set before the first move (the usual place): one value for all
         return np.full(len(moves), float(values[-1]))
-    k = np.searchsorted(rows, moves.row, side="left") - 1
+    k = searchsorted_many(rows, moves.row, side="left") - 1
     return np.where(k >= 0, np.asarray(values, float)[np.maximum(k, 0)], initial)
 
 
@@ -193,7 +208,7 @@ def happens_before(moves: PlannerMoves, rows: np.ndarray) -> np.ndarray:
         return np.zeros(len(moves), bool)
     previous = np.r_[-1, moves.row[:-1]]
     same_row = previous == moves.row  # chords of one arc have nothing between them
-    count_before = np.searchsorted(rows, moves.row, side="left") - np.searchsorted(rows, previous, side="right")
+    count_before = searchsorted_many(rows, moves.row, side="left") - searchsorted_many(rows, previous, side="right")
     return (count_before > 0) & ~same_row
 
 

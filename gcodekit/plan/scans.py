@@ -26,11 +26,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from .kernels import engine
+
 BLOCK = 4096
 
 
 def forward_min(cap: np.ndarray, inc: np.ndarray, first: float = 0.0) -> np.ndarray:
     """``m[0] = min(cap[0], first)``; ``m[i] = min(cap[i], m[i-1] + inc[i-1])``."""
+    kernels = engine(cap.size)
+    if kernels is not None:
+        return kernels.forward_min(_floats(cap), _floats(inc), float(first), BLOCK)
     n = cap.size
     out = np.empty(n)
     carry = first  # what the move before the block allows at the block's first junction
@@ -50,6 +55,9 @@ def forward_min(cap: np.ndarray, inc: np.ndarray, first: float = 0.0) -> np.ndar
 
 def backward_min(cap: np.ndarray, inc: np.ndarray, last: float = 0.0) -> np.ndarray:
     """``s[n-1] = min(cap[n-1], last + inc[n-1])``; ``s[i] = min(cap[i], s[i+1] + inc[i])``."""
+    kernels = engine(cap.size)
+    if kernels is not None:
+        return kernels.backward_min(_floats(cap), _floats(inc), float(last), BLOCK)
     n = cap.size
     out = np.empty(n)
     carry = last  # s of the move after the block
@@ -66,6 +74,10 @@ def backward_min(cap: np.ndarray, inc: np.ndarray, last: float = 0.0) -> np.ndar
         out[start:stop] = r[::-1]
         carry = out[start]
     return out
+
+
+def _floats(a: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float64)
 
 
 def _rebuild(cap: np.ndarray, s: np.ndarray, binds: np.ndarray, seed: float) -> np.ndarray:

@@ -1,0 +1,121 @@
+"""Plan stage: the compiled loops (Numba) give the NumPy planners' arrays, to the last bit.
+
+The NumPy code is the reference (itself checked against Klipper, Marlin's
+slicer estimates and the per-move oracles); planning the same program with
+each engine must give identical moves, velocities and times, bit for bit.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import gcodekit
+from gcodekit.plan import kernels, marlin, planner_settings, run_planner, scans
+
+if kernels.compiled() is None:
+    pytest.skip("Numba is not installed (pip install 'gcodekit[fast]')", allow_module_level=True)
+
+HERE = Path(__file__).parent / "golden" / "klipper"
+CASES = HERE / "cases"
+SHARED_FFF = Path(__file__).parents[2] / "shared" / "corpus" / "fff"
+
+
+def assert_bits_equal(a, b, what: str) -> None:
+    a, b = np.asarray(a), np.asarray(b)
+    assert a.shape == b.shape and a.dtype == b.dtype, what
+    if a.dtype.kind == "f":  # -0.0 and 0.0 differ, NaN equals NaN
+        differ = np.flatnonzero(a.view(np.int64) != b.view(np.int64))
+        assert differ.size == 0, f"{what}: {differ.size} differ, first at {differ[0]}: {a[differ[0]]!r} {b[differ[0]]!r}"
+    else:
+        assert np.array_equal(a, b), what
+
+
+def plan_both(op, planner: str, config):
+    out = []
+    for name in ("numpy", "numba"):
+        with kernels.using(name):
+            out.append(run_planner(op, planner, config))
+    return out
+
+
+def assert_same_plan(ref, got) -> None:
+    assert_bits_equal(ref.time, got.time, "waypoint time")
+    for field in ("speed_v", "row", "waypoint", "length_d"):
+        assert_bits_equal(getattr(ref.moves, field), getattr(got.moves, field), field)
+    for field in ("start_v", "cruise_v", "end_v", "accel", "accel_t", "cruise_t", "decel_t"):
+        assert_bits_equal(getattr(ref.result, field), getattr(got.result, field), field)
+
+
+def corpus(name: str) -> Path:
+    path = CASES / name if (CASES / name).exists() else SHARED_FFF / name
+    if not path.exists():
+        pytest.skip(f"{name} is only in the shared corpus")
+    return path
+
+
+PROGRAMS = ["cube20_marlin2.gcode", "cube20_klipper.gcode", "b_square.gcode", "c_arcs.gcode", "f_stops.gcode",
+            "g_ejunction.gcode", "cylinder_marlin2.gcode", "cylinder_marlin2_arcwelder.gcode",
+            "vase_spiral_marlin2.gcode"]
+
+
+@pytest.mark.parametrize("name", PROGRAMS)
+@pytest.mark.parametrize("classic_jerk", [False, True])
+def test_marlin_engines_agree(name, classic_jerk):
+    op = gcodekit.gcode_to_operation(corpus(name), "marlin", plan=False)
+    assert_same_plan(*plan_both(op, "marlin", marlin.MarlinConfig(classic_jerk=classic_jerk)))
+
+
+@pytest.mark.parametrize("name", PROGRAMS)
+def test_klipper_engines_agree(name):
+    config = HERE / "klipper_printer.cfg"
+    op = gcodekit.gcode_to_operation(corpus(name), "klipper", machine_config=config, plan=False)
+    assert_same_plan(*plan_both(op, "klipper", planner_settings("klipper", {}, config)))
+
+
+def test_hand_cases_agree():
+    # stops, reversals, extruder-only moves, a zero-length move, an arc, no feed yet, limits changed on the way
+    text = ("G1 X10 E1\nG1 X20 Y0 E2 F3000\nG1 X10 E3\nG1 E2 F1800\nG1 E3\nG4 P100\nG1 X10 Y10 F6000\n"
+            "M204 P500 T800\nG1 X10.001 Y10\nG2 X20 Y10 I5 J0 E4\nM205 X2 Y2\nG1 X0 Y0 Z0.2\nM400\nG1 X1\n")
+    for planner in ("marlin", "klipper"):
+        op = gcodekit.gcode_to_operation(text, planner, plan=False)
+        for config in ([marlin.MarlinConfig(), marlin.MarlinConfig(classic_jerk=True)] if planner == "marlin"
+                       else [planner_settings(planner, {})]):
+            assert_same_plan(*plan_both(op, planner, config))
+
+
+speeds_v2 = st.one_of(st.floats(0.0, 1e6), st.sampled_from([0.0, -0.0, np.inf, 1e-300, 1e-7]))
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # inf - inf in the NumPy scans' sums
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(speeds_v2, speeds_v2), max_size=40), st.sampled_from([0.0, 2.5, np.inf]),
+       st.sampled_from([1, 3, 4096]))
+def test_scans_agree(pairs, first, block):
+    cap = np.array([p[0] for p in pairs], float)
+    inc = np.array([p[1] for p in pairs], float)
+    old = scans.BLOCK
+    scans.BLOCK = block  # small blocks: the carry from block to block
+    try:
+        with kernels.using("numpy"):
+            ref = scans.forward_min(cap, inc, first), scans.backward_min(cap, inc, first)
+        with kernels.using("numba"):
+            got = scans.forward_min(cap, inc, first), scans.backward_min(cap, inc, first)
+    finally:
+        scans.BLOCK = old
+    assert_bits_equal(ref[0], got[0], "forward_min")
+    assert_bits_equal(ref[1], got[1], "backward_min")
+
+
+def test_auto_engine_by_size():
+    assert kernels.engine(10) is None
+    assert kernels.engine(kernels.COMPILED_AFTER_MOVES) is kernels.compiled()
+    with kernels.using("numpy"):
+        assert kernels.engine(10**9) is None
+    with pytest.raises(ValueError):
+        with kernels.using("fortran"):
+            pass
