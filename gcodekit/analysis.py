@@ -119,54 +119,25 @@ def velocity_profile(op: "Operation") -> "pd.DataFrame":
     return pd.DataFrame(velocity_corners(op))
 
 
-def velocity_corners(op: "Operation") -> dict[str, np.ndarray]:
+def velocity_corners(op: "Operation", *, columns: tuple[str, ...] | None = None) -> dict[str, np.ndarray]:
     """Speed over time, for plots: planned (trapezoids) and commanded.
 
     One row per corner of each move's velocity trapezoid: ``time`` (s),
     ``distance`` (mm travelled so far), ``planned`` and ``commanded`` speed
     (mm/s), and the source ``line``.  Without a planner the planned speed is
     the commanded one, held for each move.  Columns as NumPy arrays (a
-    DataFrame of a 3 M-line print's 12 M corners costs seconds to assemble).
+    DataFrame of a 3 M-line print's 12 M corners costs seconds to assemble);
+    ``columns`` (default: all five) names those to compute.
+    :class:`gcodekit.view.velocity.VelocityMoves` makes the corners of a
+    range of moves only.
     """
-    plan = op.plan
-    if plan is None:
-        w = op.waypoints
-        moved = np.flatnonzero(w["motion"] > 0)
-        t_end = op.elapsed_time()[moved]
-        dur = np.nan_to_num(np.asarray(w["time"], float)[moved])
-        speed = np.asarray(w["feed"], float)[moved] / 60.0
-        d_end = np.cumsum(np.asarray(w["distance"], float)[moved])
-        d_start = d_end - np.asarray(w["distance"], float)[moved]
-        line = op.table.line[waypoint_rows(op)[moved]]
-        return {
-            "time": np.column_stack([t_end - dur, t_end]).ravel(),
-            "distance": np.column_stack([d_start, d_end]).ravel(),
-            "planned": np.repeat(speed, 2), "commanded": np.repeat(speed, 2), "line": np.repeat(line, 2),
-        }
-    moves, r = plan
-    if len(moves) == 0:  # nothing moved: no trapezoids to lay out
-        return {c: np.zeros(0) for c in ("time", "distance", "planned", "commanded", "line")}
-    w = op.waypoints
-    # a move starts when its waypoint started plus the moves of that waypoint before it
-    dur = r.duration_t
-    t_end_wp = op.elapsed_time()
-    t_start_wp = t_end_wp - np.nan_to_num(np.asarray(w["time"], float))
-    within = np.cumsum(dur) - dur
-    first = np.r_[0, np.flatnonzero(moves.waypoint[1:] != moves.waypoint[:-1]) + 1]
-    offset = np.repeat(within[first], np.diff(np.r_[first, len(moves)]))
-    t0 = t_start_wp[moves.waypoint] + (within - offset)
-    d = moves.length_d
-    d0 = np.cumsum(d) - d
-    accel_d = (r.cruise_v**2 - r.start_v**2) / (2 * r.accel)
-    decel_d = (r.cruise_v**2 - r.end_v**2) / (2 * r.accel)
-    times = np.column_stack([t0, t0 + r.accel_t, t0 + r.accel_t + r.cruise_t, t0 + dur])
-    dist = np.column_stack([d0, d0 + accel_d, d0 + d - decel_d, d0 + d])
-    speed = np.column_stack([r.start_v, r.cruise_v, r.cruise_v, r.end_v])
-    commanded = np.repeat(moves.speed_v, 4)
-    return {
-        "time": times.ravel(), "distance": dist.ravel(), "planned": speed.ravel(), "commanded": commanded,
-        "line": np.repeat(op.table.line[moves.row], 4),
-    }
+    from .view.velocity import COLUMNS, VelocityMoves
+
+    columns = COLUMNS if columns is None else tuple(columns)
+    corners = VelocityMoves(op)
+    if len(corners) == 0:  # nothing moved: no trapezoids to lay out
+        return {c: np.zeros(0) for c in columns}
+    return corners.corners(columns=columns)
 
 
 _PART_NAME = re.compile(r"Part name:\s*(.+)")

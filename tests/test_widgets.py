@@ -12,7 +12,7 @@ import pytest
 pytest.importorskip("anywidget")
 
 import gcodekit  # noqa: E402
-from gcodekit.analysis import layers as waypoint_layers  # noqa: E402
+from gcodekit.analysis import layers as waypoint_layers, velocity_corners  # noqa: E402
 from gcodekit.widgets import LayerViewer, StageDiff, VelocityPlot  # noqa: E402
 from gcodekit.widgets.checks import check  # noqa: E402
 from gcodekit.view import Toolpath  # noqa: E402
@@ -207,19 +207,63 @@ def test_bad_input_is_a_message_not_a_traceback(source, says):
 
 def test_velocity_envelope_keeps_each_bins_extremes(cube):
     plot = VelocityPlot(cube)
-    x0, x1 = plot.xs[0], plot.xs[-1]
+    corners = velocity_corners(cube)
+    xs, planned = corners["time"], corners["planned"]
+    x0, x1 = xs[0], xs[-1]
+    assert plot.range == (x0, x1)
     p = plot.points(x0, x1, bins=300)
     assert p["mode"] == "binned" and p["x"].size <= 300
     # an independent binning of the full profile gives the same highest speed per bin
     edges = np.linspace(x0, x1, 301)
     k = 137
-    inside = (plot.xs >= edges[k]) & (plot.xs < edges[k + 1])
-    j = np.searchsorted(p["x"], plot.xs[inside][0])
-    assert p["hi"][j] == pytest.approx(plot.planned[inside].max())
-    assert p["lo"][j] == pytest.approx(plot.planned[inside].min())
+    inside = (xs >= edges[k]) & (xs < edges[k + 1])
+    j = np.searchsorted(p["x"], xs[inside][0])
+    assert p["hi"][j] == pytest.approx(planned[inside].max())
+    assert p["lo"][j] == pytest.approx(planned[inside].min())
     raw = plot.points(x0, x0 + (x1 - x0) / 5000)
     assert raw["mode"] == "raw"  # every corner, from the first move's first corner on
-    np.testing.assert_array_equal(raw["x"], plot.xs[:raw["x"].size])
+    np.testing.assert_array_equal(raw["x"], xs[:raw["x"].size])
+
+
+def corner_points(corners: dict, x: str, per_move: int, x0: float, x1: float, bins: int) -> dict:
+    """The oracle: VelocityPlot.points as it was, searching and reducing every corner of the program."""
+    xs, planned, commanded = corners[x], corners["planned"], corners["commanded"]
+    a, b = np.searchsorted(xs, x0, side="left"), np.searchsorted(xs, x1, side="right")
+    a = max(a - 1, 0)
+    a -= a % per_move
+    if b - a <= 3 * bins:
+        return {"x": xs[a:b], "lo": planned[a:b], "hi": planned[a:b], "commanded": commanded[a:b],
+                "line": corners["line"][a:b], "first": np.arange(a, b), "mode": "raw"}
+    starts = np.unique(np.searchsorted(xs[a:b], np.linspace(x0, x1, bins + 1)[:-1]))
+    starts = starts[starts < b - a]
+    return {"x": xs[a:b][starts], "lo": np.minimum.reduceat(planned[a:b], starts),
+            "hi": np.maximum.reduceat(planned[a:b], starts), "commanded": np.maximum.reduceat(commanded[a:b], starts),
+            "line": corners["line"][a:b][starts], "first": a + starts, "mode": "binned"}
+
+
+@pytest.mark.parametrize("plan", [True, False])
+@pytest.mark.parametrize("x", ["time", "distance"])
+def test_plot_points_are_every_corners_reduced(cube, plan, x):
+    """The plot lays out only the corners of the moves it shows, and gives what reducing every corner gives."""
+    op = cube if plan else gcodekit.gcode_to_operation(CUBE, plan=False)
+    plot = VelocityPlot(op, x=x)
+    corners = velocity_corners(op)
+    per_move = plot.corners
+    assert per_move == (4 if plan else 2)
+    middle = plot.profile.corners(100, 140)
+    for name, column in corners.items():  # a slice of moves: the same numbers to the bit
+        np.testing.assert_array_equal(middle[name], column[100 * per_move:140 * per_move])
+    lo, hi = plot.range
+    rng = np.random.default_rng(0)
+    ranges = [(lo, hi), (lo - 1, hi + 1), (lo, lo + (hi - lo) / 3000)]
+    ranges += [tuple(np.sort(rng.uniform(lo, hi, 2))) for _ in range(12)]
+    ranges += [(u, u + (hi - lo) * 0.001) for u in rng.uniform(lo, hi, 6)]
+    for x0, x1 in ranges:
+        for bins in (1200, 40, 3):
+            got, want = plot.points(x0, x1, bins), corner_points(corners, x, per_move, x0, x1, bins)
+            for key in ("mode", "x", "lo", "hi", "commanded", "line"):
+                np.testing.assert_array_equal(got[key], want[key], err_msg=f"{key} of {x0}..{x1}, {bins} bins")
+            np.testing.assert_array_equal(got["move"], plot.moves_of(want["first"]))
 
 
 def test_linked_plot_follows_the_viewers_range(cube):

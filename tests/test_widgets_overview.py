@@ -181,7 +181,7 @@ def test_plot_names_the_toolpaths_moves_and_shares_the_viewers_path(cube):
     plot.link(viewer)
     assert plot.path is viewer.path
     # each corner's move, found as before the plot shared the viewer's toolpath (the first at or after its waypoint)
-    corners = np.arange(0, plot.xs.size, 7)
+    corners = np.arange(0, len(plot.profile) * plot.corners, 7)
     waypoint = cube.plan[0].waypoint[corners // 4]
     expected = np.clip(np.searchsorted(Toolpath.of(cube).move_rows, waypoint), 0, len(viewer.path.move_rows) - 1)
     assert np.array_equal(plot.moves_of(corners), expected)

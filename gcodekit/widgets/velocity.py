@@ -1,10 +1,13 @@
 """Widgets stage: VelocityPlot, commanded feed against the planner's speed.
 
-The profile (:func:`gcodekit.analysis.velocity_corners`, four corners per
-planned move) can hold half a million points; the browser gets at most a
-few thousand for the range shown: every corner when they fit, else the
-lowest and highest speed per bin (a line plot drawn at pixel density looks
-the same).  ``link(viewer)`` follows a :class:`LayerViewer`'s range.
+The profile (four corners per planned move, as
+:func:`gcodekit.analysis.velocity_corners` lays them out) can hold 12 M
+points on a 3 M-line print; the plot keeps one row per move
+(:class:`gcodekit.view.velocity.VelocityMoves`) and the browser gets at most
+a few thousand points for the range shown: every corner when they fit, made
+for those moves only, else the lowest and highest speed per bin (a line plot
+drawn at pixel density looks the same), from each move's extremes.
+``link(viewer)`` follows a :class:`LayerViewer`'s range.
 """
 
 from __future__ import annotations
@@ -98,7 +101,7 @@ class VelocityPlot(PictureDisplay):
         self.view.observe(self._on_pick, "picked")
         self.widget = widgets.VBox([self.view, self.picked], layout=widgets.Layout(width="100%"))
         if layers is None:
-            self.show(self.xs[0], self.xs[-1])
+            self.show(*self.x_extent)
         else:
             self.show_layers(*layers)
 
@@ -112,49 +115,93 @@ class VelocityPlot(PictureDisplay):
         return self._path
 
     def _profile(self) -> None:
-        from ..analysis import velocity_corners
+        from ..view.velocity import VelocityMoves
 
         op = getattr(self.source, "operation", self.source)
         self._move_rows, _ = move_rows(op)  # the toolpath's moves (Toolpath.move_rows), or why there are none
         self.op = op
-        corners = velocity_corners(op)
-        if corners["time"].size == 0:
+        self.profile = v = VelocityMoves(op)
+        if len(v) == 0:
             raise ToolpathError(f"{op.file}: no moves to plot")
-        self.times = np.asarray(corners["time"], float)
-        self.xs = np.asarray(corners[self.x_name], float)
-        self.planned = np.asarray(corners["planned"], float)
-        self.commanded = np.asarray(corners["commanded"], float)
-        self.lines = np.asarray(corners["line"], np.int64)
-        if op.plan is not None:
-            self._waypoint, self.corners = op.plan[0].waypoint, 4
-        else:
-            self._waypoint, self.corners = np.flatnonzero(np.asarray(op.waypoints["motion"]) > 0), 2
-        self.ymax = float(np.fmax.reduce([np.fmax.reduce(self.planned), np.fmax.reduce(self.commanded), 1e-9])) * 1.05
+        self.corners = v.per_move
+        self._waypoint = op.plan[0].waypoint if op.plan is not None else v.moved
+        self._starts = v.start(self.x_name)
+        # each move's extremes, and one more: reduceat's last index may be the end of the profile
+        n = len(v)
+        self._lo, self._hi, self._commanded = np.full(n + 1, np.inf), np.full(n + 1, -np.inf), np.full(n + 1, -np.inf)
+        v.speed_range(out=(self._lo[:n], self._hi[:n]))
+        self._commanded[:n] = v.commanded()
+        self.ymax = float(np.fmax.reduce([np.fmax.reduce(self._hi), np.fmax.reduce(self._commanded), 1e-9])) * 1.05
+
+    @property
+    def x_extent(self) -> tuple[float, float]:
+        """The first and last corner's x: the whole program."""
+        last = self.profile.corners(len(self.profile) - 1, None, (self.x_name,))[self.x_name]
+        return float(self._starts[0]), float(last[-1])
 
     def moves_of(self, points: np.ndarray) -> np.ndarray:
         """The toolpath move (index of ``path.move_rows``) of each of the profile's points ``points``."""
         rows = self._move_rows
         return np.clip(np.searchsorted(rows, self._waypoint[np.asarray(points) // self.corners]), 0, len(rows) - 1)
 
+    def corner_index(self, x: np.ndarray, side: str = "left") -> np.ndarray:
+        """``np.searchsorted`` of ``x`` in every corner's x, found from each move's first corner and one move's corners."""
+        x = np.atleast_1d(np.asarray(x, float))
+        m = np.searchsorted(self._starts, x, side=side) - 1  # the last move starting before x (at or before: right)
+        inside = m >= 0
+        own = self.profile.corners_of(np.maximum(m, 0), (self.x_name,))[self.x_name].reshape(-1, self.corners)
+        count = (own < x[:, None]) if side == "left" else (own <= x[:, None])
+        return np.where(inside, m * self.corners + count.sum(axis=1), 0)
+
     def points(self, x0: float, x1: float, bins: int = BINS) -> dict[str, np.ndarray]:
         """What is drawn for ``x0..x1``: every corner, or per-bin min/max when more than ``3 * bins``.
 
         Returns ``x, lo, hi, commanded, line, move`` and ``mode`` (``"raw"`` or ``"binned"``).
         """
-        a, b = np.searchsorted(self.xs, [x0, x1], side="left")[0], np.searchsorted(self.xs, x1, side="right")
+        c = self.corners
+        a, b = int(self.corner_index(x0, "left")[0]), int(self.corner_index(x1, "right")[0])
         a = max(a - 1, 0)  # the corner before the range starts its first line
-        a -= a % self.corners  # whole moves: corner k of the points is then corner k % corners of its move
-        x, planned = self.xs[a:b], self.planned[a:b]
-        if x.size <= 3 * bins:
-            return {"x": x, "lo": planned, "hi": planned, "commanded": self.commanded[a:b], "line": self.lines[a:b],
+        a -= a % c  # whole moves: corner k of the points is then corner k % corners of its move
+        if b - a <= 3 * bins:
+            got = self.profile.corners(a // c, -(-b // c), (self.x_name, "planned", "commanded", "line"))
+            planned = got["planned"][:b - a]
+            return {"x": got[self.x_name][:b - a], "lo": planned, "hi": planned,
+                    "commanded": got["commanded"][:b - a], "line": got["line"][:b - a],
                     "move": self.moves_of(np.arange(a, b)), "mode": "raw"}
         edges = np.linspace(x0, x1, bins + 1)
-        starts = np.unique(np.searchsorted(x, edges[:-1]))
-        starts = starts[starts < x.size]
-        return {"x": x[starts], "lo": np.minimum.reduceat(planned, starts),
-                "hi": np.maximum.reduceat(planned, starts),
-                "commanded": np.maximum.reduceat(self.commanded[a:b], starts),
-                "line": self.lines[a:b][starts], "move": self.moves_of(a + starts), "mode": "binned"}
+        starts = np.unique(np.clip(self.corner_index(edges[:-1], "left") - a, 0, b - a))
+        first = a + starts[starts < b - a]  # each bin's first corner; the last bin ends at b
+        lo, hi, commanded = self._bins(first, b)
+        x = self.profile.corners_of(first // c, (self.x_name,))[self.x_name].reshape(-1, c)
+        return {"x": x[np.arange(first.size), first % c], "lo": lo, "hi": hi, "commanded": commanded,
+                "line": self.profile.line[first // c], "move": self.moves_of(first), "mode": "binned"}
+
+    def _bins(self, first: np.ndarray, end: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Lowest and highest planned and highest commanded speed over corners ``first[k]`` to ``first[k + 1]``.
+
+        What ``minimum.reduceat`` over every corner gives, from each move's
+        extremes for the moves a bin holds whole and the corners of the (at
+        most two) moves it holds in part.
+        """
+        c, v = self.corners, self.profile
+        lo_m, hi_m, cmd_m = self._lo, self._hi, self._commanded
+        stop = np.r_[first[1:], end]
+        whole0, whole1 = -(-first // c), stop // c  # the moves held whole: [whole0, whole1)
+        has_whole = whole1 > whole0
+        index = np.column_stack([whole0, np.maximum(whole1, whole0)]).ravel()
+        out = []
+        for per_move, ufunc, none in ((lo_m, np.minimum, np.inf), (hi_m, np.maximum, -np.inf)):
+            value = np.where(has_whole, ufunc.reduceat(per_move, index)[::2], none)
+            for move in (first // c, np.minimum(stop // c, len(v) - 1)):  # the first and last move, in part
+                corner = move[:, None] * c + np.arange(c)
+                held = (corner >= first[:, None]) & (corner < stop[:, None])
+                planned = v.corners_of(move, ("planned",))["planned"].reshape(-1, c)
+                value = ufunc(value, ufunc.reduce(np.where(held, planned, none), axis=1))
+            out.append(value)
+        # a move's commanded speed is one for all its corners: the moves the bin touches
+        last = (stop - 1) // c
+        commanded = np.maximum.reduceat(cmd_m, np.column_stack([first // c, last + 1]).ravel())[::2]
+        return out[0], out[1], commanded
 
     # -- what is shown ---------------------------------------------------------------
 
@@ -183,8 +230,16 @@ class VelocityPlot(PictureDisplay):
         start, end = self._move_times
         t0, t1 = start[first], end[last]
         if self.x_name == "distance":
-            t0, t1 = np.interp([t0, t1], self.times, self.xs)
+            t0, t1 = self._distance_at(np.array([t0, t1]))
         self.show(t0, t1)
+
+    def _distance_at(self, t: np.ndarray) -> np.ndarray:
+        """Distance travelled at times ``t``: interpolated between the corners of the move around each."""
+        v, c = self.profile, self.corners
+        m = np.clip(np.searchsorted(v.start("time"), t, side="right") - 1, 0, len(v) - 1)
+        got = v.corners_of(m, ("time", "distance"))
+        times, dist = got["time"].reshape(-1, c), got["distance"].reshape(-1, c)
+        return np.array([np.interp(t[k], times[k], dist[k]) for k in range(t.size)])
 
     def show_layers(self, lo: int, hi: int) -> None:
         """Show layers (or Z levels) ``lo..hi``."""
