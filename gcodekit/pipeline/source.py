@@ -19,7 +19,7 @@ from ..emulate.machine import Machine
 from ..errors import Diagnostics
 from ..limits import Limits
 from ..parse import CommandTable
-from ..read import Blocks, iter_blocks, iter_lines
+from ..read import Blocks, iter_counted_blocks, iter_lines
 from ..read.percent import until_closing_percent
 from ..syntax import Flavor
 from .feedback import MachineFeedback, MachineStop
@@ -91,19 +91,17 @@ def program_blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, b
         chunks = program.chunks(diagnostics)
     if flavor.percent_delimiter:
         chunks = until_closing_percent(chunks)
-    lines_read = [0, 0]  # lines taken from the chunks, lines handed on with blocks
-
-    def counted():
-        for c in chunks:
-            lines_read[0] += c.count(b"\n")
-            if bar is not None:
-                bar.update(len(c))
-            yield c
-
+    if bar is not None:
+        chunks = _shown(chunks, bar)
     size = program.path.stat().st_size if program.path is not None and not program.preprocessed else 0
-    for blocks in iter_blocks(counted(), flavor, diagnostics, size_hint=size):  # each holds every chunk taken so far
-        yield blocks, lines_read[0] - lines_read[1]
-        lines_read[1] = lines_read[0]
+    yield from iter_counted_blocks(chunks, flavor, diagnostics, size_hint=size)  # each holds every chunk taken so far
+
+
+def _shown(chunks: Iterator[bytes], bar) -> Iterator[bytes]:
+    """The chunks, each counted on the progress bar as it is taken."""
+    for c in chunks:
+        bar.update(len(c))
+        yield c
 
 
 def number_other_files(lines: Iterator, main: str, diagnostics: Diagnostics) -> Iterator:

@@ -28,7 +28,7 @@ from .scan import fast_path_possible, scan
 from .source import MAX_LINE_LENGTH, iter_lines, open_program, program_lines
 from .tokenize import LineTokenizer, RawBlock
 
-__all__ = ["Block", "Blocks", "Word", "read_text", "read_file", "iter_blocks", "iter_lines",
+__all__ = ["Block", "Blocks", "Word", "read_text", "read_file", "iter_blocks", "iter_counted_blocks", "iter_lines",
            "open_program", "program_lines", "read_source_lines", "iter_source_blocks", "MAX_LINE_LENGTH"]
 
 #: Preprocessed lines read into one chunk of blocks (see :func:`iter_source_blocks`)
@@ -65,6 +65,13 @@ def iter_blocks(
     :data:`COMPILED_CHUNK_BYTES`: a yielded chunk holds every chunk taken
     from ``chunks`` so far, none read ahead.
     """
+    for blocks, _ in iter_counted_blocks(chunks, flavor, diagnostics, engine=engine, size_hint=size_hint):
+        yield blocks
+
+
+def iter_counted_blocks(chunks: Iterable[bytes], flavor: Flavor, diagnostics: Diagnostics, *, engine: str = "auto",
+                        size_hint: int = 0) -> Iterator[tuple[Blocks, int]]:
+    """:func:`iter_blocks`, each chunk's blocks with its number of lines (the scanner counts them anyway)."""
     check_choice("engine", engine, ENGINES)
     if engine == "numba" and scan_kernel.compiled() is None:
         raise MissingDependencyError("the compiled scanner needs Numba: pip install 'gcodekit[fast]'")
@@ -86,9 +93,9 @@ def iter_blocks(
             data, pending, waiting = b"".join(pending), [], 0
         part, lines = _read(data, first_line, flavor, tokenizer, diagnostics, fast, compiled)
         first_line += lines
-        yield part
+        yield part, lines
     if pending:
-        yield _read(b"".join(pending), first_line, flavor, tokenizer, diagnostics, fast, True)[0]
+        yield _read(b"".join(pending), first_line, flavor, tokenizer, diagnostics, fast, True)
 
 
 def _read(data: bytes, first_line: int, flavor: Flavor, tokenizer: LineTokenizer, diagnostics: Diagnostics,
