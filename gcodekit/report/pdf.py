@@ -69,7 +69,7 @@ class Browser:
     def __init__(self) -> None:
         # a plain directory, not a TemporaryDirectory, whose finalizer would remove it in a forked child too
         self._profile = tempfile.mkdtemp(prefix="gcodekit-chromium-")
-        to_chromium, self._send = os.pipe()
+        to_chromium, self._pipe = os.pipe()
         self._receive, from_chromium = os.pipe()
         # above 9, so that putting them on 3 and 4 below cannot overwrite one with the other
         to_chromium, from_chromium = (_above_9(fd) for fd in (to_chromium, from_chromium))
@@ -84,7 +84,12 @@ class Browser:
         self._next_id = 0
         self._events: list[dict[str, Any]] = []
         self._target: str | None = None
-        self._session: str | None = None  # of the tab pages are printed in, made by the first print
+        self._session: str | None = None  # of the tab pages are printed in, attached by the first print
+        # the tab asked for now, not awaited: Chromium opens it (and starts its renderer on a file: page, the
+        # kind reports are) as soon as it has booted, while the report is still being drawn
+        blank = Path(self._profile, "blank.html")
+        blank.write_text("<!DOCTYPE html><title></title>", encoding="utf-8")
+        self._tab_request: int | None = self._send("Target.createTarget", url=blank.as_uri())
 
     def _read(self) -> dict[str, Any]:
         while b"\0" not in self._buffer:
@@ -98,18 +103,29 @@ class Browser:
 
     def call(self, method: str, session: str | None = None, **params: Any) -> dict[str, Any]:
         """Send one DevTools command and return its result; events that arrive meanwhile are kept."""
+        return self._reply(self._send(method, session, **params), method)
+
+    def _send(self, method: str, session: str | None = None, **params: Any) -> int:
+        """Send one DevTools command without waiting; its id, for :meth:`_reply`."""
         self._next_id += 1
         message = {"id": self._next_id, "method": method, "params": params}
         if session:
             message["sessionId"] = session
-        os.write(self._send, json.dumps(message).encode() + b"\0")
-        while True:
-            reply = self._read()
-            if reply.get("id") == self._next_id:
-                if "error" in reply:
-                    raise RuntimeError(f"chromium: {method}: {reply['error'].get('message')}")
-                return reply["result"]
-            self._events.append(reply)
+        os.write(self._pipe, json.dumps(message).encode() + b"\0")
+        return self._next_id
+
+    def _reply(self, request: int, method: str) -> dict[str, Any]:
+        """The result of the command ``request``; other messages that arrive meanwhile are kept."""
+        for k, m in enumerate(self._events):
+            if m.get("id") == request:
+                reply = self._events.pop(k)
+                break
+        else:
+            while (reply := self._read()).get("id") != request:
+                self._events.append(reply)
+        if "error" in reply:
+            raise RuntimeError(f"chromium: {method}: {reply['error'].get('message')}")
+        return reply["result"]
 
     def _wait(self, event: str, session: str) -> None:
         while True:
@@ -126,7 +142,11 @@ class Browser:
         renderer each time, a third to a half of a print's CPU.
         """
         if self._session is None:
-            self._target = self.call("Target.createTarget", url="about:blank")["targetId"]
+            if self._tab_request is not None:
+                request, self._tab_request = self._tab_request, None
+                self._target = self._reply(request, "Target.createTarget")["targetId"]
+            else:
+                self._target = self.call("Target.createTarget", url="about:blank")["targetId"]
             self._session = self.call("Target.attachToTarget", targetId=self._target, flatten=True)["sessionId"]
             self.call("Page.enable", session=self._session)
         try:
@@ -151,7 +171,7 @@ class Browser:
             self.call("Browser.close")
         except (OSError, RuntimeError):
             pass
-        for fd in (self._send, self._receive):
+        for fd in (self._pipe, self._receive):
             os.close(fd)
         try:
             self._proc.wait(10)
@@ -162,7 +182,7 @@ class Browser:
 
     def forget(self) -> None:
         """Close this process's ends of the pipe only: in a forked child, Chromium is the parent's."""
-        for fd in (self._send, self._receive):
+        for fd in (self._pipe, self._receive):
             os.close(fd)
 
 
