@@ -585,14 +585,14 @@ _WORK_INDEX = {c: i + 1 for i, c in enumerate(("G54", "G55", "G56", "G57", "G58"
 def _dense(col, rows: slice) -> np.ndarray:
     if isinstance(col, np.ndarray):
         return col[rows].copy()
-    return col.dense()[rows]
+    return col.window(rows.start, rows.stop)
 
 
 def _take(t: CommandTable, letter: str, rows: np.ndarray) -> np.ndarray:
     col = t.params.get(letter)
     if col is None:
         return np.full(rows.size, np.nan)
-    return (col if isinstance(col, np.ndarray) else col.dense())[rows]
+    return col[rows] if isinstance(col, np.ndarray) else t.param_at(letter, rows)
 
 
 def _forward_fill(values: np.ndarray, initial: float) -> np.ndarray:
