@@ -30,7 +30,7 @@ def assert_bits_equal(a, b, what: str) -> None:
     assert a.shape == b.shape and a.dtype == b.dtype, what
     if a.dtype.kind == "f":  # -0.0 and 0.0 differ, NaN equals NaN
         differ = np.flatnonzero(a.view(np.int64) != b.view(np.int64))
-        assert differ.size == 0, f"{what}: {differ.size} differ, first at {differ[0]}: {a[differ[0]]!r} {b[differ[0]]!r}"
+        assert differ.size == 0, f"{what}: {differ.size} differ, first {differ[0]}: {a[differ[0]]!r} {b[differ[0]]!r}"
     else:
         assert np.array_equal(a, b), what
 
@@ -86,6 +86,14 @@ def test_hand_cases_agree():
         for config in ([marlin.MarlinConfig(), marlin.MarlinConfig(classic_jerk=True)] if planner == "marlin"
                        else [planner_settings(planner, {})]):
             assert_same_plan(*plan_both(op, planner, config))
+
+
+def test_klipper_limits_changed_on_the_way():
+    text = ("G1 X10 E1 F3000\nSET_VELOCITY_LIMIT VELOCITY=40 ACCEL=800 SQUARE_CORNER_VELOCITY=2\nG1 X10 Y10 E2\n"
+            "G1 Z1 F600\nG1 X0 Y0 Z0.5 E2.5 F6000\nM204 S1500\nG1 X5 E1.5\nG1 E2\n"
+            "SET_VELOCITY_LIMIT MINIMUM_CRUISE_RATIO=0.3\nG1 X5 Y5\nG1 X0 Y5 E3\n")
+    op = gcodekit.gcode_to_operation(text, "klipper", plan=False)
+    assert_same_plan(*plan_both(op, "klipper", planner_settings("klipper", {})))
 
 
 speeds_v2 = st.one_of(st.floats(0.0, 1e6), st.sampled_from([0.0, -0.0, np.inf, 1e-300, 1e-7]))

@@ -43,7 +43,8 @@ def compiled() -> SimpleNamespace | None:
     except ImportError:
         return None
     jit = numba.njit(cache=True, nogil=True)
-    return SimpleNamespace(forward_min=jit(_forward_min), backward_min=jit(_backward_min))
+    return SimpleNamespace(forward_min=jit(_forward_min), backward_min=jit(_backward_min),
+                           classic_jerk=jit(_classic_jerk), klipper_moves=jit(_klipper_moves))
 
 
 def engine(n_moves: int) -> SimpleNamespace | None:
@@ -150,3 +151,185 @@ def _backward_min(cap, inc, last, block):
                 out[k] = seed + s
         carry = out[start]
     return out
+
+
+def _classic_jerk(dx, dy, dz, de, speed_per_mm, nominal_speed, jx, jy, jz, je, rest_before):
+    """:func:`.marlin._classic_jerk` move by move (the previous move of the first is itself).
+
+    ``jx``.. ``je`` hold one jerk limit per move, or one for all.
+    """
+    n = nominal_speed.size
+    safe_speed = np.empty(n)
+    vmax = np.empty(n)
+    for i in range(n):
+        p = i - 1 if i > 0 else 0
+        previous_nominal_speed = nominal_speed[p]
+        v = nominal_speed[i]
+        vmax_junction = v if (v < previous_nominal_speed or v != v) else previous_nominal_speed
+        exit_scale = speed_per_mm[p] * (vmax_junction / previous_nominal_speed)
+        safe_factor = 1.0
+        v_factor = 1.0
+        for axis in range(4):
+            if axis == 0:
+                d, limits = dx, jx
+            elif axis == 1:
+                d, limits = dy, jy
+            elif axis == 2:
+                d, limits = dz, jz
+            else:
+                d, limits = de, je
+            maxj = limits[i] if limits.size > 1 else limits[0]
+            v_entry = d[i] * speed_per_mm[i]
+            v_exit = d[p] * exit_scale
+            cs = abs(v_entry)
+            ratio = maxj / cs if cs > maxj else 1.0
+            if not (safe_factor < ratio or safe_factor != safe_factor):
+                safe_factor = ratio
+            if v_exit > v_entry:
+                if v_entry > 0 or v_exit < 0:
+                    jerk = v_exit - v_entry
+                else:
+                    a, b = v_exit, -v_entry
+                    jerk = a if (a > b or a != a) else b
+            else:
+                if v_entry < 0 or v_exit > 0:
+                    jerk = v_entry - v_exit
+                else:
+                    a, b = -v_exit, v_entry
+                    jerk = a if (a > b or a != a) else b
+            ratio = maxj / jerk if jerk > maxj else 1.0
+            if not (v_factor < ratio or v_factor != v_factor):
+                v_factor = ratio
+        safe_speed[i] = v * safe_factor
+        vmax[i] = vmax_junction * v_factor
+    for i in range(n):
+        p = i - 1 if i > 0 else 0
+        threshold = vmax[i] * 0.99
+        if rest_before[i] or (safe_speed[p] > threshold and safe_speed[i] > threshold):
+            vmax[i] = safe_speed[i]
+    return vmax
+
+
+def _klipper_moves(start, end, speed_v, row, flush, limit_rows, max_velocity, max_accel, square_corner_velocity,
+                   minimum_cruise_ratio, initial, z_velocity, z_accel, e_velocity, e_accel, corner_velocity,
+                   extrude_only_accel, no_limit_v2):
+    """:func:`.klipper._move_block` over all moves: Move.__init__, limit_speed and calc_junction.
+
+    The limits in force come from ``limit_rows`` (sorted) and their columns,
+    ``initial`` (max_velocity, max_accel, square_corner_velocity,
+    minimum_cruise_ratio) before the first, as :func:`.moves.in_force`.
+    Returns move_d, accel, max_cruise_v2, delta_v2, mcr_delta_v2, cap and junction.
+    """
+    n = speed_v.size
+    move_d_out = np.empty(n)
+    accel_out = np.empty(n)
+    max_cruise_v2_out = np.empty(n)
+    delta_v2_out = np.empty(n)
+    mcr_delta_v2_out = np.empty(n)
+    cap_out = np.empty(n)
+    junction = np.empty(n, np.bool_)
+    inf = np.inf
+    sqrt2_minus_1 = np.sqrt(2.0) - 1.0
+    j = 0  # limit rows before the move's row
+    p_kinematic = False
+    p_e_r = p_r0 = p_r1 = p_r2 = p_jd = 0.0
+    for i in range(n):
+        r = row[i]
+        if j > 0 and limit_rows[j - 1] >= r:  # out of order (a loop ran rows again): search afresh
+            j = np.searchsorted(limit_rows, r)
+        while j < limit_rows.size and limit_rows[j] < r:
+            j += 1
+        if j > 0:
+            max_v, max_a = max_velocity[j - 1], max_accel[j - 1]
+            scv, mcr = square_corner_velocity[j - 1], minimum_cruise_ratio[j - 1]
+        else:
+            max_v, max_a, scv, mcr = initial[0], initial[1], initial[2], initial[3]
+        jd = scv * scv * sqrt2_minus_1 / max_a
+        mcr_pseudo_accel = max_a * (1.0 - mcr)
+        dx = end[i, 0] - start[i, 0]
+        dy = end[i, 1] - start[i, 1]
+        dz = end[i, 2] - start[i, 2]
+        de = end[i, 3] - start[i, 3]
+        move_d = np.sqrt((dx * dx + dy * dy) + dz * dz)
+        kinematic = move_d >= 1e-9
+        if not kinematic:
+            dx = dy = dz = 0.0
+            move_d = abs(de)
+        inv_move_d = 1.0 / move_d if move_d > 0 else 0.0
+        r0, r1, r2, e_r = dx * inv_move_d, dy * inv_move_d, dz * inv_move_d, de * inv_move_d
+        speed = speed_v[i]
+        if kinematic:
+            velocity = speed if (speed < max_v or speed != speed) else max_v
+            accel = max_a
+        else:
+            velocity = speed
+            accel = extrude_only_accel
+        max_cruise_v2 = velocity * velocity
+        mcr_delta_v2 = 2.0 * move_d * mcr_pseudo_accel
+        abs_dz = abs(dz)
+        z_move = kinematic and abs_dz > 0
+        z_ratio = move_d / abs_dz if z_move else inf
+        e_limited = de != 0 and ((dx == 0 and dy == 0) or e_r < 0)
+        inv_extrude_r = 1.0 / abs(e_r) if e_limited else inf
+        a = z_velocity * z_ratio if z_move else inf
+        b = e_velocity * inv_extrude_r if e_limited else inf
+        speed_cap = a if (a < b or a != a) else b
+        b = speed_cap * speed_cap
+        if not (max_cruise_v2 < b or max_cruise_v2 != max_cruise_v2):
+            max_cruise_v2 = b
+        b = z_accel * z_ratio if z_move else inf
+        if not (accel < b or accel != accel):
+            accel = b
+        b = e_accel * inv_extrude_r if e_limited else inf
+        if not (accel < b or accel != accel):
+            accel = b
+        delta_v2 = 2.0 * move_d * accel
+        if not (mcr_delta_v2 < delta_v2 or mcr_delta_v2 != mcr_delta_v2):
+            mcr_delta_v2 = delta_v2
+        joins = False
+        cap = 0.0
+        if i > 0:
+            diff_r = e_r - p_e_r
+            if diff_r != 0:
+                ea_v2 = corner_velocity / abs(diff_r)
+                ea_v2 = ea_v2 * ea_v2
+            else:
+                ea_v2 = max_cruise_v2
+            p_max_cruise_v2 = max_cruise_v2_out[i - 1]
+            cap = max_cruise_v2 if (max_cruise_v2 < p_max_cruise_v2 or max_cruise_v2 != max_cruise_v2) \
+                else p_max_cruise_v2
+            if not (cap < ea_v2 or cap != cap):
+                cap = ea_v2
+            if not (cap < no_limit_v2 or cap != cap):
+                cap = no_limit_v2
+            junction_cos_theta = -((r0 * p_r0 + r1 * p_r1) + r2 * p_r2)
+            x = 0.5 * (1.0 - junction_cos_theta)
+            sin_theta_d2 = np.sqrt(x if (x > 0.0 or x != x) else 0.0)
+            x = 0.5 * (1.0 + junction_cos_theta)
+            cos_theta_d2 = np.sqrt(x if (x > 0.0 or x != x) else 0.0)
+            one_minus_sin_theta_d2 = 1.0 - sin_theta_d2
+            if one_minus_sin_theta_d2 > 0 and cos_theta_d2 > 0:
+                R_jd = sin_theta_d2 / one_minus_sin_theta_d2
+                quarter_tan_theta_d2 = 0.25 * sin_theta_d2 / cos_theta_d2
+                corner = R_jd * jd * accel
+                b = R_jd * p_jd * accel_out[i - 1]
+                if not (corner < b or corner != corner):
+                    corner = b
+                b = delta_v2 * quarter_tan_theta_d2
+                if not (corner < b or corner != corner):
+                    corner = b
+                b = delta_v2_out[i - 1] * quarter_tan_theta_d2
+                if not (corner < b or corner != corner):
+                    corner = b
+                if not (cap < corner or cap != cap):
+                    cap = corner
+            joins = kinematic and p_kinematic and not flush[i]
+        junction[i] = joins
+        cap_out[i] = cap if joins else 0.0
+        move_d_out[i] = move_d
+        accel_out[i] = accel
+        max_cruise_v2_out[i] = max_cruise_v2
+        delta_v2_out[i] = delta_v2
+        mcr_delta_v2_out[i] = mcr_delta_v2
+        p_kinematic, p_e_r, p_r0, p_r1, p_r2, p_jd = kinematic, e_r, r0, r1, r2, jd
+    return move_d_out, accel_out, max_cruise_v2_out, delta_v2_out, mcr_delta_v2_out, cap_out, junction

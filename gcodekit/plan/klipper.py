@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..memory import release_freed_memory
+from .kernels import engine
 from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
 
@@ -214,11 +215,15 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
     flush = happens_before(moves, command_rows(op, names=flush_names, codes=("SET_KINEMATIC_POSITION",)))
     flush[0] = True
 
-    m = {k: np.empty(n) for k in ("move_d", "accel", "max_cruise_v2", "delta_v2", "mcr_delta_v2", "cap")}
-    junction = np.empty(n, bool)
-    for lo in range(0, n, BLOCK):
-        hi = min(lo + BLOCK, n)
-        _move_block(moves, rows, limits, config, flush, lo, hi, m, junction)
+    compiled = engine(n)
+    if compiled is not None:
+        m, junction = _compiled_moves(compiled, moves, rows, limits, config, flush)
+    else:
+        m = {k: np.empty(n) for k in ("move_d", "accel", "max_cruise_v2", "delta_v2", "mcr_delta_v2", "cap")}
+        junction = np.empty(n, bool)
+        for lo in range(0, n, BLOCK):
+            hi = min(lo + BLOCK, n)
+            _move_block(moves, rows, limits, config, flush, lo, hi, m, junction)
     planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, m["move_d"])
     del moves  # the end points are no longer needed: free them before the passes
     release_freed_memory()
@@ -234,6 +239,19 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
     del mcr_start_v2, m["max_cruise_v2"], m["delta_v2"], m["mcr_delta_v2"]  # free before the trapezoids
     release_freed_memory()
     return planned, _set_junction(start_v2, cruise_v2, next_start_v2, m)
+
+
+def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict, np.ndarray]:
+    """What :func:`_move_block` computes, for all moves in one compiled loop."""
+    names = ("max_velocity", "max_accel", "square_corner_velocity", "minimum_cruise_ratio")
+    out = compiled.klipper_moves(
+        np.ascontiguousarray(moves.start, float), np.ascontiguousarray(moves.end, float),
+        np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row, np.int64), flush,
+        np.ascontiguousarray(rows, np.int64), *(np.ascontiguousarray(limits[k], float) for k in names),
+        np.array([float(getattr(config, k)) for k in names]), float(config.max_z_velocity or config.max_velocity),
+        float(config.max_z_accel or config.max_accel), float(config.max_e_velocity), float(config.max_e_accel),
+        float(config.instantaneous_corner_velocity), EXTRUDE_ONLY_ACCEL, NO_LIMIT_V2)
+    return dict(zip(("move_d", "accel", "max_cruise_v2", "delta_v2", "mcr_delta_v2", "cap"), out[:6])), out[6]
 
 
 def _move_block(moves, rows, limits, config, flush, lo, hi, m, junction) -> None:

@@ -39,6 +39,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..memory import release_freed_memory
+from .kernels import engine
 from .lookahead import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
 from .moves import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before,
                     m204_in_force, settings_in_force, speed_factor)
@@ -295,8 +296,9 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     rest_before = happens_before(moves, command_rows(op, names=REST_NAMES))
     rest_before[0] = True
     block = {name: np.empty(n) for name in ("millimeters", "acceleration", "nominal_speed", "max_entry_speed_sqr")}
+    compiled = engine(n)
     for lo in range(0, n, BLOCK):
-        _populate_blocks(moves, lim, rest_before, config, lo, min(lo + BLOCK, n), block)
+        _populate_blocks(moves, lim, rest_before, config, lo, min(lo + BLOCK, n), block, compiled)
     del lim
     millimeters, acceleration, nominal_speed = block["millimeters"], block["acceleration"], block["nominal_speed"]
     planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, millimeters)
@@ -318,8 +320,9 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
 
 
 def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, config: MarlinConfig,
-                     lo: int, hi: int, out: dict) -> None:
-    """``_populate_block`` for moves ``lo:hi``: length, nominal speed, acceleration, junction speed."""
+                     lo: int, hi: int, out: dict, kernels=None) -> None:
+    """``_populate_block`` for moves ``lo:hi``: length, nominal speed, acceleration, junction speed
+    (the classic-jerk junctions by the compiled loop of ``kernels``, when given)."""
     first = max(lo - 1, 0)  # the move before the block, for its junction
     sl = slice(first, hi)
     lim = {k: [_at(a, sl) for a in v] if isinstance(v, list) else _at(v, sl) for k, v in lim.items()}
@@ -349,7 +352,11 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
 
     rest = rest_before[sl]
     prev = np.r_[0, np.arange(hi - first - 1)]
-    if config.classic_jerk:
+    if config.classic_jerk and kernels is not None:
+        max_jerk = [np.ascontiguousarray(j, dtype=float).reshape(-1) for j in lim["max_jerk"]]
+        vmax_junction = kernels.classic_jerk(*dist_mm, speed_per_mm, nominal_speed, *max_jerk, rest)
+        max_entry_speed_sqr = vmax_junction * vmax_junction
+    elif config.classic_jerk:
         vmax_junction = _classic_jerk(dist_mm, speed_per_mm, nominal_speed, lim["max_jerk"], prev, rest)
         max_entry_speed_sqr = vmax_junction * vmax_junction
     else:

@@ -153,7 +153,8 @@ def searchsorted_many(a: np.ndarray, v: np.ndarray, side: str = "left") -> np.nd
     if 8 * a.size > v.size or not (v.size < 2 or bool(np.all(v[1:] >= v[:-1]))):
         return np.searchsorted(a, v, side=side)
     at = np.searchsorted(v, a, side="right" if side == "left" else "left")
-    return np.cumsum(np.bincount(at, minlength=v.size + 1)[:v.size])
+    counts = np.bincount(at, minlength=v.size + 1)[:v.size]
+    return np.cumsum(counts, out=counts)
 
 
 def in_force(moves: PlannerMoves, rows: np.ndarray, values: np.ndarray, initial: float) -> np.ndarray:
