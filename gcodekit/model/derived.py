@@ -116,9 +116,17 @@ def row_labels(op: "Operation", pattern: str) -> tuple[np.ndarray, list[str]]:
 
 def features(op: "Operation") -> np.ndarray:
     """Feature name (slicer ``;TYPE:`` comment) of each waypoint; ``""`` before the first."""
+    codes, names = feature_codes(op)
+    return np.array(names, dtype=object)[codes]
+
+
+def feature_codes(op: "Operation") -> tuple[np.ndarray, list[str]]:
+    """:func:`features` as an index per waypoint into a list of names (``""``, then each comment's in order).
+
+    Colourings and checks use these: millions of strings cost seconds to compare or sort.
+    """
     marks, labels = row_labels(op, op.flavor.feature_comment if op.flavor else "")
-    names = np.array([""] + labels, dtype=object)
-    return names[marks[waypoint_rows(op)] + 1]
+    return marks[waypoint_rows(op)] + 1, [""] + labels
 
 
 def layers(op: "Operation", heights: np.ndarray | None = None) -> np.ndarray:

@@ -135,6 +135,11 @@ class Operation:
         return self._kept("features", lambda: derived.features(self))
 
     @property
+    def feature_codes(self) -> tuple[np.ndarray, list[str]]:
+        """:attr:`features` as an index per waypoint into a list of names (see :func:`~gcodekit.model.derived.feature_codes`)."""
+        return self._kept("feature_codes", lambda: derived.feature_codes(self))
+
+    @property
     def layers(self) -> np.ndarray:
         """Per waypoint, its layer (0 first, -1 before the first; see :mod:`gcodekit.model.derived`).
 

@@ -46,6 +46,8 @@ PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e
            "#dbdb8d", "#9edae5")
 #: Travel (moves that lay no material, rapids) when drawn: one grey.
 TRAVEL_COLOR = "#9a9a9a"
+#: Moves looked at first to see whether a waypoint column varies (the whole column only when these do not).
+VARIES_FROM = 64
 #: Name of a category for waypoints before the first feature comment.
 NO_FEATURE = "(none)"
 
@@ -59,12 +61,14 @@ def waypoint_scalars(op: "Operation", by: str) -> tuple[np.ndarray, list[str] | 
     """
     w = op.waypoints
     if by == "feature":
-        # a few names over millions of waypoints: look each up (sorting millions of strings took seconds)
-        labels = op.features.tolist()
-        names = sorted(set(labels))
+        # a few names over millions of waypoints: the comments' codes renumbered (strings took seconds)
+        codes, labels = op.feature_codes
+        present = np.flatnonzero(np.bincount(codes, minlength=len(labels)))
+        names = sorted({labels[k] for k in present})
         index = {name: k for k, name in enumerate(names)}
-        codes = np.fromiter(map(index.__getitem__, labels), np.int32, count=len(labels))
-        return codes, [n or NO_FEATURE for n in names]
+        table = np.zeros(len(labels), np.int32)
+        table[present] = [index[labels[k]] for k in present]
+        return table[codes], [n or NO_FEATURE for n in names]
     if by == "speed":
         d, t = np.asarray(w["distance"], float), np.nan_to_num(np.asarray(w["time"], float))
         return np.divide(d, t, out=np.zeros_like(d), where=t > 0), None
@@ -78,7 +82,10 @@ def waypoint_scalars(op: "Operation", by: str) -> tuple[np.ndarray, list[str] | 
 
 def has_features(op: "Operation") -> bool:
     """Whether the program names its features (slicer ``;TYPE:`` comments)."""
-    return bool(op.flavor is not None and op.flavor.feature_comment and (op.features != "").any())
+    if op.flavor is None or not op.flavor.feature_comment:
+        return False
+    codes, labels = op.feature_codes
+    return any(labels[k] for k in np.flatnonzero(np.bincount(codes, minlength=len(labels))))
 
 
 def default_coloring(op: "Operation") -> str:
@@ -100,15 +107,20 @@ def choices(path: Toolpath) -> list[str]:
         named.append("flow")
     moves = np.zeros(len(op.waypoints["x"]), bool)
     moves[path.move_rows] = True
-    # a column that never changes over the moves would paint everything one colour (reduced in place: no copies)
+    # a column that never changes over the moves would paint everything one colour
     columns = sorted(k for k, v in op.waypoints.items()
-                     if k not in HIDDEN and k not in named and _varies(np.asarray(v), moves))
+                     if k not in HIDDEN and k not in named and _varies(np.asarray(v), path.move_rows, moves))
     return named + columns
 
 
-def _varies(values: np.ndarray, where: np.ndarray) -> bool:
+def _varies(values: np.ndarray, rows: np.ndarray, where: np.ndarray) -> bool:
+    """Whether ``values`` differ among the waypoints ``rows`` (``where`` marks them), NaN counting as unknown."""
+    head = values[rows[:VARIES_FROM]].astype(float)
+    if head.min() < head.max() and (values.dtype.kind != "f" or not np.isnan(values).any()):
+        return True  # seen among the first moves: most columns that vary do so at once
     if values.dtype.kind != "f":
         values = values.astype(float)
+    # reduced in place (no copy of the selected values); a NaN among them gives False
     return bool(values.max(where=where, initial=-np.inf) > values.min(where=where, initial=np.inf))
 
 
@@ -179,13 +191,13 @@ class Coloring:
         return ListedColormap(self.table() / 255.0)
 
 
-def coloring(path: Toolpath, by: str) -> Coloring:
-    """The per-segment values of colouring ``by`` (see :func:`choices`).
+def coloring(path: Toolpath, by: str, offered: list[str] | None = None) -> Coloring:
+    """The per-segment values of colouring ``by`` (see :func:`choices`; ``offered``: what it returned, if known).
 
     A categorical colouring keeps only the categories the moves have, in order.
     """
     op, rows = path.op, path.move_rows
-    offered = choices(path)
+    offered = choices(path) if offered is None else offered
     # what the program offers first; any named colouring or waypoint column is drawn when asked for
     check_choice("color_by", by, [*offered, *(k for k in [*TITLES, *sorted(op.waypoints)]
                                               if k not in offered and k not in HIDDEN and k != "flow")])

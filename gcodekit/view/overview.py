@@ -26,20 +26,28 @@ Examples
 
 from __future__ import annotations
 
+from typing import Sequence
+
 import numpy as np
 
 #: A run of segments ends where the path turns by more than this (degrees): corners stay corners.
 CORNER_DEG = 45.0
 
 
-def runs(start: np.ndarray, end: np.ndarray, key: np.ndarray) -> np.ndarray:
-    """First segment of each run: where the key (n,) or (n, k) changes, the path turns by more than
-    :data:`CORNER_DEG` or a segment does not start at the one before's end."""
+def runs(start: np.ndarray, end: np.ndarray, key: "np.ndarray | Sequence[np.ndarray]") -> np.ndarray:
+    """First segment of each run: where the key (n,), (n, k) or k columns (n,) changes, the path turns by
+    more than :data:`CORNER_DEG` or a segment does not start at the one before's end."""
     n = start.shape[0]
     if n == 0:
         return np.zeros(0, np.int64)
-    same = key[1:] == key[:-1]
-    joined = (np.all(same, axis=1) if same.ndim == 2 else same) & np.all(end[:-1] == start[1:], axis=1)
+    if isinstance(key, np.ndarray):
+        same = key[1:] == key[:-1]
+        joined = np.all(same, axis=1) if same.ndim == 2 else same
+    else:  # column by column: no (n, k) copy of them
+        joined = np.ones(n - 1, bool)
+        for column in key:
+            joined &= column[1:] == column[:-1]
+    joined &= np.all(end[:-1] == start[1:], axis=1)
     d = end - start
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     # cos(turn) * |a| |b| = a . b: no division (zero-length segments then end no run)
@@ -47,7 +55,7 @@ def runs(start: np.ndarray, end: np.ndarray, key: np.ndarray) -> np.ndarray:
     return np.flatnonzero(np.r_[True, ~joined])
 
 
-def chords(start: np.ndarray, end: np.ndarray, key: np.ndarray, stride: int) -> tuple[np.ndarray, np.ndarray]:
+def chords(start: np.ndarray, end: np.ndarray, key: "np.ndarray | Sequence[np.ndarray]", stride: int) -> tuple[np.ndarray, np.ndarray]:
     """Each run of segments in chords of ``stride`` segments (its last chord shorter): first and last segment of each."""
     n = start.shape[0]
     run_first = runs(start, end, key)
@@ -63,7 +71,7 @@ def _chords(run_first: np.ndarray, n: int, stride: int) -> tuple[np.ndarray, np.
     return first, np.r_[first[1:], n] - 1
 
 
-def overview(start: np.ndarray, end: np.ndarray, key: np.ndarray, budget: int) -> tuple[np.ndarray, np.ndarray, int]:
+def overview(start: np.ndarray, end: np.ndarray, key: "np.ndarray | Sequence[np.ndarray]", budget: int) -> tuple[np.ndarray, np.ndarray, int]:
     """At most ``budget`` chords standing for the segments: first and last segment of each, and the stride.
 
     Every segment when they fit (stride 1); else the smallest stride whose

@@ -196,8 +196,8 @@ class LayerViewer(PictureDisplay):
     def _recolor(self) -> None:
         """Colour by the dropdown's choice: the overview's chords (their runs keep one colour) and their values."""
         path = self.path
-        self._coloring = color = coloring(path, self.color_by.value)
-        key = np.column_stack([path.segment_group, path.kind, color.values])
+        self._coloring = color = coloring(path, self.color_by.value, list(self.color_by.options))
+        key = (path.segment_group, path.kind, color.values)
         first, last, stride = overview(path.start, path.end, key, self.max_segments)
         self._chords = first, last
         chord_group = path.segment_group[first]
