@@ -127,10 +127,14 @@ class Browser:
             raise RuntimeError(f"chromium: {method}: {reply['error'].get('message')}")
         return reply["result"]
 
-    def _wait(self, event: str, session: str) -> None:
+    def _wait_for_load(self, session: str, loader: str) -> None:
+        """Until the document of the navigation ``loader`` has loaded: not any load event, which may be the
+        blank page's the tab opened with."""
         while True:
             for k, m in enumerate(self._events):
-                if m.get("method") == event and m.get("sessionId") == session:
+                p = m.get("params", {})
+                if (m.get("method") == "Page.lifecycleEvent" and m.get("sessionId") == session
+                        and p.get("name") == "load" and p.get("loaderId") == loader):
                     del self._events[k]
                     return
             self._events.append(self._read())
@@ -149,11 +153,12 @@ class Browser:
                 self._target = self.call("Target.createTarget", url="about:blank")["targetId"]
             self._session = self.call("Target.attachToTarget", targetId=self._target, flatten=True)["sessionId"]
             self.call("Page.enable", session=self._session)
+            self.call("Page.setLifecycleEventsEnabled", session=self._session, enabled=True)
         try:
-            error = self.call("Page.navigate", session=self._session, url=url).get("errorText")
-            if error:
-                raise RuntimeError(f"chromium could not open {url}: {error}")
-            self._wait("Page.loadEventFired", self._session)
+            navigation = self.call("Page.navigate", session=self._session, url=url)
+            if navigation.get("errorText"):
+                raise RuntimeError(f"chromium could not open {url}: {navigation['errorText']}")
+            self._wait_for_load(self._session, navigation["loaderId"])
             data = self.call("Page.printToPDF", session=self._session, printBackground=True,
                              preferCSSPageSize=True, displayHeaderFooter=False)["data"]
         except (OSError, RuntimeError):
