@@ -1,8 +1,8 @@
-"""Parse stage: the compiled rows loop (Numba) gives the NumPy passes' command table, to the last bit.
+"""Parse stage: the compiled loops (Numba) give the NumPy passes' command table, to the last bit.
 
 The NumPy passes are the reference (themselves checked against the
-splitter and the golden comparisons); the compiled loop of
-:mod:`gcodekit.parse.rows_kernel` must give identical rows, parameters
+splitter and the golden comparisons); the compiled loops of
+:mod:`gcodekit.parse.rows_kernel` must give identical block summaries, rows, parameters
 (bit for bit) and diagnostics on every input, and the pipeline the same
 operation whichever builds the rows.
 """
@@ -20,7 +20,7 @@ from test_read import FAST_FLAVORS, program
 
 import gcodekit
 from gcodekit.errors import Diagnostics
-from gcodekit.parse import GcodeParser, rows_kernel
+from gcodekit.parse import GcodeParser, parser, rows_kernel
 from gcodekit.parse.table import SparseColumn
 from gcodekit.read import read_file, read_text
 from gcodekit.testing import assert_operations_equal
@@ -43,6 +43,11 @@ def _same_array(a, b, what):
 
 
 def assert_same_tables(blocks, flavor: str) -> None:
+    n_letter = GcodeParser(flavor)._n_letter
+    ref = parser._block_words(blocks.word_block, blocks.word_letter, len(blocks), n_letter)
+    got = rows_kernel.block_words_compiled(blocks.word_block, blocks.word_letter, len(blocks), n_letter, parser._AXIS)
+    for name, a, b in zip(("n_codes", "has_param", "has_axis", "code_word"), ref, got):
+        _same_array(a, b, name)
     tables, said = [], []
     for engine in ("numpy", "numba"):
         diagnostics = Diagnostics("t")
@@ -120,7 +125,7 @@ def test_without_numba_the_numpy_passes_parse_and_numba_is_asked_for_by_name():
 import sys
 sys.modules["numba"] = None
 from gcodekit.errors import MissingDependencyError
-from gcodekit.parse import GcodeParser, rows_kernel
+from gcodekit.parse import GcodeParser, parser, rows_kernel
 from gcodekit.read import read_text
 rows_kernel.COMPILED_FROM_BLOCKS = 0
 table = GcodeParser("marlin").parse(read_text("G1 X1.5\\nT2\\n", flavor="marlin"))

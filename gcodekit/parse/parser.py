@@ -44,6 +44,10 @@ PARAM_LETTERS = "ABCDEFGHIJKLMNOPQRSTUVWXYZ@^"
 _LETTER_ROW = np.full(256, -1, np.int64)
 _LETTER_ROW[[ord(c) for c in PARAM_LETTERS]] = np.arange(len(PARAM_LETTERS))
 
+#: Axis word letters (by byte)
+_AXIS = np.zeros(256, bool)
+_AXIS[[ord(c) for c in AXIS_LETTERS]] = True
+
 #: Motion modes by command name.  A probe (G38.x) is a straight feed to its
 #: target: without a probe input it never trips, as in rs274 standalone.
 _MOTION_MODES = {**MOTION_OF_NAME, "probe": MOTION_LINEAR, "spline_cubic": MOTION_CUBIC,
@@ -110,22 +114,24 @@ class GcodeParser:
             self._note_log_comment(blocks)
         n_blocks = len(blocks)
         wb, wl = blocks.word_block, blocks.word_letter
-        is_code = (wl == _G) | (wl == _M)
-        is_param = ~is_code & (wl != self._n_letter)
-        n_codes = np.bincount(wb[is_code], minlength=n_blocks)
-        has_param = np.bincount(wb[is_param], minlength=n_blocks) > 0
+        compiled = rows_kernel.use_compiled(self.engine, n_blocks)
+        if compiled:
+            n_codes, has_param, has_axis, code_word = rows_kernel.block_words_compiled(wb, wl, n_blocks,
+                                                                                       self._n_letter, _AXIS)
+        else:
+            n_codes, has_param, has_axis, code_word = _block_words(wb, wl, n_blocks, self._n_letter)
         has_comment = np.bincount(blocks.comment_block, minlength=n_blocks) > 0
 
         compound = n_codes >= 2
         if blocks.extras:
             compound[list(blocks.extras)] = True
         if self._modal_motion:
-            compound |= self._axis_words_on_non_consumer(blocks, is_code, is_param, n_codes)
+            compound |= self._axis_words_on_non_consumer(blocks, has_axis, n_codes, code_word)
         if self.flavor.block_split == "sequential":
-            compound |= has_param & (n_codes == 1) & self._params_before_code(wb, is_code, n_blocks)
+            compound |= has_param & (n_codes == 1) & self._params_before_code(wb, _is_code(wl), n_blocks)
         simple = ~compound & ((n_codes == 1) | has_param | has_comment)
 
-        fast = self._simple_rows(blocks, simple, is_code, is_param)
+        fast = self._simple_rows(blocks, simple, compiled)
         slow = self._compound_rows(blocks, np.flatnonzero(compound))
         rows = _merge_rows(fast, slow)
         _read_as_e(rows["params"], self._extruder_letters)
@@ -162,17 +168,15 @@ class GcodeParser:
 
     # -- bulk path ------------------------------------------------------------
 
-    def _axis_words_on_non_consumer(self, blocks, is_code, is_param, n_codes) -> np.ndarray:
+    def _axis_words_on_non_consumer(self, blocks, has_axis, n_codes, code_word) -> np.ndarray:
         """Blocks like ``G90 X0``: one code that does not take the axis words."""
-        wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
-        axis = is_param & in_ids(wl, [ord(c) for c in AXIS_LETTERS])
-        has_axis = np.bincount(wb[axis], minlength=len(blocks)) > 0
-        code_rows = np.flatnonzero(is_code)
-        consumer = np.zeros(len(blocks), bool)
-        names = self._name_ids(wl[code_rows], wv[code_rows])
+        candidates = np.flatnonzero(has_axis & (n_codes == 1))
+        words = code_word[candidates]
+        names = self._name_ids(blocks.word_letter[words], blocks.word_value[words])
         consumer_ids = np.array([NAME_ID[n] for n in AXIS_CONSUMERS if n in NAME_ID])
-        consumer[wb[code_rows]] = in_ids(names, consumer_ids)
-        return has_axis & (n_codes == 1) & ~consumer
+        out = np.zeros(len(blocks), bool)
+        out[candidates] = ~in_ids(names, consumer_ids)
+        return out
 
     @staticmethod
     def _params_before_code(wb, is_code, n_blocks) -> np.ndarray:
@@ -185,15 +189,15 @@ class GcodeParser:
         first_code[wb[codes][::-1]] = codes[::-1]
         return first_word < first_code
 
-    def _simple_rows(self, blocks: Blocks, simple: np.ndarray, is_code, is_param) -> dict:
+    def _simple_rows(self, blocks: Blocks, simple: np.ndarray, compiled: bool) -> dict:
         rows_blocks = np.flatnonzero(simple)
-        if rows_kernel.use_compiled(self.engine, len(blocks)):
+        if compiled:
             letter, number, present, table, repeats = rows_kernel.simple_rows_compiled(
                 blocks.word_block, blocks.word_letter, blocks.word_value, rows_blocks, len(blocks), self._n_letter,
                 _LETTER_ROW)
         else:
-            letter, number, present, table, repeats = self._simple_rows_numpy(blocks, rows_blocks, simple, is_code,
-                                                                              is_param)
+            letter, number, present, table, repeats = self._simple_rows_numpy(blocks, rows_blocks, simple,
+                                                                              self._n_letter)
         for row, j, word in repeats.tolist():
             line = int(blocks.block_line[blocks.word_block[word]])
             self.diagnostics.report(line, int(blocks.word_col[word]),
@@ -209,9 +213,11 @@ class GcodeParser:
         }
 
     @staticmethod
-    def _simple_rows_numpy(blocks: Blocks, rows_blocks: np.ndarray, simple: np.ndarray, is_code, is_param):
+    def _simple_rows_numpy(blocks: Blocks, rows_blocks: np.ndarray, simple: np.ndarray, n_letter: int):
         """The rows of one-code blocks by NumPy passes (the reference of :mod:`.rows_kernel`)."""
         wb, wl, wv = blocks.word_block, blocks.word_letter, blocks.word_value
+        is_code = _is_code(wl)
+        is_param = ~is_code & (wl != n_letter)
         n = rows_blocks.size
         row_of_block = np.full(len(blocks), -1, np.int64)
         row_of_block[rows_blocks] = np.arange(n)
@@ -459,6 +465,24 @@ class GcodeParser:
             else:  # firmware add codes freely (M900, M620, ...): say once, quietly, that it does nothing here
                 self.diagnostics.report(line, 1, f"{code} has no meaning in gcodekit's {self.flavor.name} flavor; "
                                         "kept as a command without effect on the path", severity="info")
+
+
+def _is_code(word_letter: np.ndarray) -> np.ndarray:
+    return (word_letter == _G) | (word_letter == _M)
+
+
+def _block_words(wb: np.ndarray, wl: np.ndarray, n_blocks: int, n_letter: int):
+    """Per block: its number of G and M codes, whether it has parameter words and axis words, and
+    its last code word (-1 for none); the NumPy reference of :func:`.rows_kernel.block_words_compiled`."""
+    is_code = _is_code(wl)
+    is_param = ~is_code & (wl != n_letter)
+    n_codes = np.bincount(wb[is_code], minlength=n_blocks)
+    has_param = np.bincount(wb[is_param], minlength=n_blocks) > 0
+    has_axis = np.bincount(wb[is_param & _AXIS.take(wl)], minlength=n_blocks) > 0
+    code_word = np.full(n_blocks, -1, np.int64)
+    code_words = np.flatnonzero(is_code)
+    code_word[wb[code_words]] = code_words
+    return n_codes, has_param, has_axis, code_word
 
 
 def _first_of_repeats(word_value: np.ndarray, table: np.ndarray, pw, prow, pslot, width: int,

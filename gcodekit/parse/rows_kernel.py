@@ -1,12 +1,13 @@
-"""Parse stage, fast path compiled: the rows of one-code blocks in one loop over the words, with Numba.
+"""Parse stage, fast path compiled: the block summaries and the rows of one-code blocks as loops over the words, with Numba.
 
-:meth:`GcodeParser._simple_rows <gcodekit.parse.parser.GcodeParser>` builds
-the rows of the blocks holding at most one code (nearly every line of a
-slicer's output) with a dozen NumPy passes over the words, each a masked
-gather or scatter as long as the chunk; this is the loop those passes
-vectorize, compiled when Numba is installed (``pip install 'gcodekit[fast]'``).
-The NumPy passes stay the reference: the tests run both on the same blocks
-and require identical rows, bit for bit.
+:class:`~gcodekit.parse.parser.GcodeParser` first sums up each block (its
+codes, whether it has parameter and axis words), then builds the rows of
+the blocks holding at most one code (nearly every line of a slicer's
+output), with a dozen NumPy passes over the words, each a masked gather or
+scatter as long as the chunk; these are the loops those passes vectorize,
+compiled when Numba is installed (``pip install 'gcodekit[fast]'``).  The
+NumPy passes stay the reference: the tests run both on the same blocks and
+require identical summaries and rows, bit for bit.
 
 The rule, word by word (words are ordered by block): a G or M word is the
 row's code; a T word in a row without one is the command (printer tool
@@ -23,7 +24,7 @@ import sys
 
 import numpy as np
 
-__all__ = ["compiled", "use_compiled", "simple_rows_compiled", "COMPILED_FROM_BLOCKS"]
+__all__ = ["compiled", "use_compiled", "block_words_compiled", "simple_rows_compiled", "COMPILED_FROM_BLOCKS"]
 
 #: Chunks of fewer blocks stay with NumPy: the loop pays off only when Numba is loaded anyway
 COMPILED_FROM_BLOCKS = 10_000
@@ -33,12 +34,13 @@ _G, _M, _T = ord("G"), ord("M"), ord("T")
 
 @functools.lru_cache(maxsize=1)
 def compiled():
-    """The compiled rows loop, or None when Numba is not installed (compiled on first use, cached on disk)."""
+    """The compiled loops (block words, rows), or None when Numba is not installed (compiled on first use,
+    cached on disk)."""
     try:
         import numba
     except ImportError:
         return None
-    return numba.njit(cache=True, nogil=True)(_rows)
+    return numba.njit(cache=True, nogil=True)(_block_words), numba.njit(cache=True, nogil=True)(_rows)
 
 
 def use_compiled(engine: str, n_blocks: int) -> bool:
@@ -65,7 +67,7 @@ def simple_rows_compiled(word_block: np.ndarray, word_letter: np.ndarray, word_v
     such word) and the repeated letters as (row, table row, second word)
     in the order of ``row * len(present) + table row``.
     """
-    letter, code_value, present, table, repeats = compiled()(
+    letter, code_value, present, table, repeats = compiled()[1](
         word_block, word_letter, word_value, rows_blocks, n_blocks, n_letter, letter_row)
     number = np.full(letter.size, -1, np.int32)
     coded = letter != 0
@@ -73,6 +75,32 @@ def simple_rows_compiled(word_block: np.ndarray, word_letter: np.ndarray, word_v
     if repeats.shape[0] > 1:
         repeats = repeats[np.argsort(repeats[:, 0] * present.size + repeats[:, 1], kind="stable")]
     return letter, number, present, table, repeats
+
+
+def block_words_compiled(word_block: np.ndarray, word_letter: np.ndarray, n_blocks: int, n_letter: int,
+                         axis: np.ndarray):
+    """Per block: its number of G and M codes, whether it has parameter words and axis words (``axis``:
+    a table by byte), and its last code word, -1 for none (as ``parser._block_words``)."""
+    return compiled()[0](word_block, word_letter, n_blocks, n_letter, axis)
+
+
+def _block_words(wb, wl, n_blocks, n_letter, axis):
+    """The loop of :func:`block_words_compiled`."""
+    n_codes = np.zeros(n_blocks, np.int64)
+    has_param = np.zeros(n_blocks, np.bool_)
+    has_axis = np.zeros(n_blocks, np.bool_)
+    code_word = np.full(n_blocks, -1, np.int64)
+    for k in range(wb.size):
+        b = wb[k]
+        c = wl[k]
+        if c == _G or c == _M:
+            n_codes[b] += 1
+            code_word[b] = k
+        elif c != n_letter:
+            has_param[b] = True
+            if axis[c]:
+                has_axis[b] = True
+    return n_codes, has_param, has_axis, code_word
 
 
 def _rows(wb, wl, wv, rows_blocks, n_blocks, n_letter, letter_row):
