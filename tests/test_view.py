@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import gcodekit
+from gcodekit.read.source import ProgramLines, program_lines
 from gcodekit.view import (CHORD_ANGLE_DEG, PALETTE, TRAVEL, WORK, Camera, Toolpath, ToolpathError, coloring,
                            move_masks, source_lines)
 
@@ -101,6 +102,18 @@ def test_source_lines_read_every_container(tmp_path, suffix, encode):
     program.write_bytes(encode(PROGRAM))
     op = gcodekit.gcode_to_operation(program, "linuxcnc", plan=False)
     assert source_lines(op) == PROGRAM_LINES
+    lazy = ProgramLines(program)  # the viewer's panel: decoded a line at a time
+    assert len(lazy) == len(PROGRAM_LINES) and list(lazy) == PROGRAM_LINES
+    assert lazy[-1] == PROGRAM_LINES[-1] and lazy[2:5] == PROGRAM_LINES[2:5]
+
+
+def test_program_lines_one_at_a_time_keep_what_cannot_be_decoded(tmp_path):
+    program = tmp_path / "odd.ngc"
+    program.write_bytes(b"G0 X0\nG1 X1 (caf\xe9 \xff)\n\nG1 X2 (\xc3\xa9t\xc3\xa9)\n")
+    assert list(ProgramLines(program)) == program_lines(program) == ["G0 X0", "G1 X1 (caf\ufffd \ufffd)", "",
+                                                                    "G1 X2 (\u00e9t\u00e9)"]
+    with pytest.raises(IndexError):
+        ProgramLines(program)[4]
 
 
 @pytest.mark.parametrize("suffix, compress", [(".bz2", bz2.compress), (".xz", lzma.compress)])

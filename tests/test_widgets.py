@@ -202,6 +202,26 @@ def test_bad_input_is_a_message_not_a_traceback(source, says):
         assert widget._repr_mimebundle_()["image/png"].startswith(b"\x89PNG")
 
 
+def test_a_large_programs_source_lines_wait_for_the_cell(cube, monkeypatch):
+    """Read on a thread started by IPython's post_run_cell event: the first picture does not wait for them."""
+    IPython = pytest.importorskip("IPython")
+    from IPython.core.events import EventManager, available_events
+
+    from gcodekit.widgets import layer_viewer
+
+    shell = type("Shell", (), {})()
+    shell.events = EventManager(shell, available_events)
+    monkeypatch.setattr(IPython, "get_ipython", lambda: shell)
+    monkeypatch.setattr(layer_viewer, "SOURCE_BYTES_NOW", 0)
+    viewer = LayerViewer(cube)
+    assert "reading the program" in viewer.code.value and not viewer._reading.is_alive()
+    shell.events.trigger("post_run_cell", None)  # the cell has finished
+    viewer._reading.join()
+    line = viewer.current_line()
+    assert f'data-line="{line}"' in viewer.code.value and "reading the program" not in viewer.code.value
+    assert not shell.events.callbacks["post_run_cell"]  # once
+
+
 # -- VelocityPlot ------------------------------------------------------------------------
 
 

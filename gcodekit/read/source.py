@@ -37,11 +37,13 @@ import io
 import lzma
 import os
 import zlib
-from typing import IO, Iterator, Union
+from typing import IO, Iterator, Sequence, Union
+
+import numpy as np
 
 from ..errors import Diagnostics
 
-__all__ = ["Source", "iter_lines", "open_program", "program_lines", "MAX_LINE_LENGTH", "CHUNK_BYTES"]
+__all__ = ["Source", "iter_lines", "open_program", "program_lines", "ProgramLines", "MAX_LINE_LENGTH", "CHUNK_BYTES"]
 
 Source = Union[str, os.PathLike, bytes]
 CHUNK_BYTES = 256 << 10  # small chunks keep the per-chunk arrays (about 60 bytes per input byte) small
@@ -153,6 +155,32 @@ def program_lines(source: Source) -> list[str]:
     """
     text = b"".join(iter_lines(source)).decode("utf-8", "replace")
     return text.split("\n")[:-1] if text else []
+
+
+class ProgramLines(Sequence[str]):
+    """:func:`program_lines` decoded one line at a time, when asked (line ``k`` is item ``k - 1``).
+
+    Keeps the program's bytes and where each line ends, 8 bytes a line: a
+    3 M-line print's list of strings took a second and a few hundred MB,
+    for a panel that shows a dozen lines at a time.
+    """
+
+    def __init__(self, source: Source):
+        self._data = b"".join(iter_lines(source))
+        self._ends = np.flatnonzero(np.frombuffer(self._data, np.uint8) == ord("\n"))
+
+    def __len__(self) -> int:
+        return int(self._ends.size)
+
+    def __getitem__(self, k):  # an int, or a slice (a list)
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        if k < 0:
+            k += len(self)
+        if not 0 <= k < len(self):
+            raise IndexError(f"line {k + 1} of {len(self)}")
+        start = int(self._ends[k - 1]) + 1 if k else 0
+        return self._data[start:int(self._ends[k])].decode("utf-8", "replace")
 
 
 class _LineSplitter:

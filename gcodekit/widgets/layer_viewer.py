@@ -26,7 +26,9 @@ import ipywidgets as widgets
 import numpy as np
 import traitlets
 
-from ..view import Camera, Coloring, Toolpath, ToolpathError, choices, coloring, overview, source_lines
+from ..read.source import ProgramLines
+from ..view import Camera, Coloring, Toolpath, ToolpathError, choices, coloring, overview
+from .cell import after_cell
 from .display import PictureDisplay, friendly, message_html
 from .picture import message_figure, toolpath_figure
 from .toolpath import load_toolpath
@@ -124,7 +126,7 @@ class LayerViewer(PictureDisplay):
         self.details_sent = 0
         self.path: Toolpath | None = None
         self.camera = Camera()
-        self._lines: list[str] | None = None
+        self._lines: ProgramLines | list[str] | None = None
         self._reading: threading.Thread | None = None
         try:
             self.path = load_toolpath(source, group_by)
@@ -311,18 +313,22 @@ class LayerViewer(PictureDisplay):
                            f'white-space:pre">line {line}, move {self.current_move}<br>{"".join(rows)}</div>')
 
     def _read_lines(self) -> bool:
-        """Whether the source lines are read; a large file is read on a thread, which shows them when done."""
+        """Whether the source lines are read; a large file is read on a thread once the cell has finished
+        (the first picture does not wait for it), which shows them when done."""
         path = Path(self.path.op.file)
-        if not path.is_file() or path.stat().st_size <= SOURCE_BYTES_NOW:
-            self._lines = source_lines(self.path.op) or []
+        if not path.is_file():
+            self._lines = []
+            return True
+        if path.stat().st_size <= SOURCE_BYTES_NOW:
+            self._lines = ProgramLines(path)
             return True
         if self._reading is None:
             def read():
-                self._lines = source_lines(self.path.op) or []
+                self._lines = ProgramLines(path)
                 self._show_code()
 
             self._reading = threading.Thread(target=read, name="gcodekit-source-lines", daemon=True)
-            self._reading.start()
+            after_cell(self._reading.start)
         return False
 
     def figure(self, size: tuple[int, int] = (800, 600)):
