@@ -246,7 +246,7 @@ def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict,
     names = ("max_velocity", "max_accel", "square_corner_velocity", "minimum_cruise_ratio")
     out = compiled.klipper_moves(
         np.ascontiguousarray(moves.start, float), np.ascontiguousarray(moves.end, float),
-        np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row, np.int64), flush,
+        np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row), flush,
         np.ascontiguousarray(rows, np.int64), *(np.ascontiguousarray(limits[k], float) for k in names),
         np.array([float(getattr(config, k)) for k in names]), float(config.max_z_velocity or config.max_velocity),
         float(config.max_z_accel or config.max_accel), float(config.max_e_velocity), float(config.max_e_accel),

@@ -42,7 +42,7 @@ from ..memory import release_freed_memory
 from .kernels import engine
 from .lookahead import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
 from .moves import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before,
-                    m204_in_force, settings_in_force, speed_factor)
+                    StepSetting, m204_in_force, settings_in_force, speed_factor)
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -268,7 +268,8 @@ def _program_limits(op: "EmulatedProgram", moves: PlannerMoves, config: MarlinCo
         "min_travel_feedrate": settings_in_force(op, moves, m205, "T", config.min_travel_feedrate),
     }
     limits.update(m204_in_force(op, moves, m204, {"P": ("acceleration", config.acceleration),
-                                                  "T": ("travel_acceleration", config.travel_acceleration)}))
+                                                  "T": ("travel_acceleration", config.travel_acceleration)},
+                                 steps=True))
     return limits
 
 
@@ -325,7 +326,8 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
     (the classic-jerk junctions by the compiled loop of ``kernels``, when given)."""
     first = max(lo - 1, 0)  # the move before the block, for its junction
     sl = slice(first, hi)
-    lim = {k: [_at(a, sl) for a in v] if isinstance(v, list) else _at(v, sl) for k, v in lim.items()}
+    row = moves.row[sl]
+    lim = {k: [_at(a, sl, row) for a in v] if isinstance(v, list) else _at(v, sl, row) for k, v in lim.items()}
     axes_d = moves.end[sl] - moves.start[sl]
     dist_mm = [np.ascontiguousarray(axes_d[:, a]) for a in range(4)]  # X, Y, Z, E columns
     del axes_d
@@ -370,8 +372,10 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
     out["max_entry_speed_sqr"][lo:hi] = max_entry_speed_sqr[k:]
 
 
-def _at(value, sl: slice):
-    """A limit for the moves in ``sl``: a number stays a number."""
+def _at(value, sl: slice, row: np.ndarray):
+    """A limit for the moves in ``sl`` (their command rows ``row``): a number stays a number."""
+    if isinstance(value, StepSetting):
+        return value.at(row)
     return value[sl] if isinstance(value, np.ndarray) else value
 
 

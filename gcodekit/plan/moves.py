@@ -39,9 +39,9 @@ class PlannerMoves:
         X, Y, Z and extruder position (mm) at both ends.
     speed_v : ndarray, shape (n,)
         Requested speed (mm/s): the feed rate over 60 times the speed factor.
-    row : ndarray of int64
+    row : ndarray of int32 (int64 past 2**31 rows)
         Command row each move comes from.
-    waypoint : ndarray of int64
+    waypoint : ndarray of int32 (int64 past 2**31 waypoints)
         Waypoint each move belongs to (several for a segmented arc).
     """
 
@@ -77,7 +77,7 @@ class PlannedMoves:
     ----------
     speed_v : ndarray
         Requested speed (mm/s).
-    row, waypoint : ndarray of int64
+    row, waypoint : ndarray of int32 (int64 past 2**31)
         Command row and waypoint each move comes from.
     length_d : ndarray
         Toolhead travel (mm); the extruder's for extruder-only moves.
@@ -159,20 +159,39 @@ def searchsorted_many(a: np.ndarray, v: np.ndarray, side: str = "left") -> np.nd
 
 def in_force(moves: PlannerMoves, rows: np.ndarray, values: np.ndarray, initial: float) -> np.ndarray:
     """Per move, the last value set by a command row before the move's row."""
-    if rows.size == 0 or len(moves) == 0 or rows[0] >= moves.row[-1]:
-        return np.full(len(moves), initial, dtype=float)
-    if rows[-1] < moves.row[0]:  # set before the first move (the usual place): one value for all
-        return np.full(len(moves), float(values[-1]))
-    k = searchsorted_many(rows, moves.row, side="left") - 1
-    return np.where(k >= 0, np.asarray(values, float)[np.maximum(k, 0)], initial)
+    return StepSetting(rows, values, initial).at(moves.row)
+
+
+@dataclass(frozen=True)
+class StepSetting:
+    """A setting that command ``rows`` change to ``values`` (``initial`` before the first).
+
+    Kept as the changes, not one value per move, so that a planner reads it
+    a block of moves at a time (:meth:`at`): one array fewer at the peak.
+    """
+
+    rows: np.ndarray
+    values: np.ndarray
+    initial: float
+
+    def at(self, row: np.ndarray) -> np.ndarray:
+        """The value in force at each of the command rows ``row``: the last set before it."""
+        rows, n = self.rows, row.size
+        if rows.size == 0 or n == 0 or rows[0] >= row[-1]:
+            return np.full(n, self.initial, dtype=float)
+        if rows[-1] < row[0]:  # set before the first move (the usual place): one value for all
+            return np.full(n, float(self.values[-1]))
+        k = searchsorted_many(rows, row, side="left") - 1
+        return np.where(k >= 0, np.asarray(self.values, float)[np.maximum(k, 0)], self.initial)
 
 
 def m204_in_force(op: "EmulatedProgram", moves: PlannerMoves, rows: np.ndarray,
-                  targets: dict[str, tuple[str, float]]) -> dict[str, np.ndarray]:
+                  targets: dict[str, tuple[str, float]], *, steps: bool = False) -> dict[str, np.ndarray]:
     """M204 per move: S sets every acceleration, a named word (P, T) overrides it.
 
     ``targets`` maps a word letter to (result name, value before any M204).
-    Marlin 2 (M204.cpp) and RepRapFirmware 3 read it this way.
+    Marlin 2 (M204.cpp) and RepRapFirmware 3 read it this way.  With
+    ``steps`` each is a :class:`StepSetting` to read a block at a time.
     """
     t = op.table
     s_word = t.param_at("S", rows)
@@ -181,7 +200,8 @@ def m204_in_force(op: "EmulatedProgram", moves: PlannerMoves, rows: np.ndarray,
         word = t.param_at(letter, rows)
         value = np.where(np.isnan(word), s_word, word)
         given = ~np.isnan(value)
-        out[name] = in_force(moves, rows[given], value[given], default)
+        setting = StepSetting(rows[given], value[given], default)
+        out[name] = setting if steps else setting.at(moves.row)
     return out
 
 
@@ -249,7 +269,7 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
         changed[:1] |= col[:1] != 0
         changed[1:] |= col[1:] != col[:-1]
     full_circle = (w["motion"] >= 3) & (w["distance"] > 0)  # ends where it started
-    idx = np.flatnonzero((w["motion"] > 0) & ~homing & (changed | full_circle))
+    idx = _narrow(np.flatnonzero((w["motion"] > 0) & ~homing & (changed | full_circle)), n)
     del changed
     start, end = _move_ends(columns, idx)
     del e, columns
@@ -257,9 +277,15 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     if speed_factor is not None:
         speed *= speed_factor[idx]
     is_arc = w["motion"][idx] >= 3
+    rows = _narrow(rows[idx], len(op.table))
     if arc_segments is None or not is_arc.any():
-        return PlannerMoves(start, end, speed, rows[idx], idx)
-    return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows[idx], arc_segments)
+        return PlannerMoves(start, end, speed, rows, idx)
+    return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows, arc_segments)
+
+
+def _narrow(index: np.ndarray, bound: int) -> np.ndarray:
+    """Indices below ``bound`` as int32 when it fits: a move's row and waypoint take half the memory."""
+    return index.astype(np.int32) if bound < 2**31 else index
 
 
 def _chords_within_limit(op, chords: np.ndarray, angle: np.ndarray, rows: np.ndarray, room: int) -> np.ndarray:
