@@ -25,6 +25,7 @@ Examples
 
     python benchmarks/bench_startup.py                 # 5 runs of each, about a minute
     python benchmarks/bench_startup.py --quick --json out.json
+    python benchmarks/bench_startup.py --phases        # where the time goes, stage by stage
 """
 
 from __future__ import annotations
@@ -86,6 +87,40 @@ def run_once(cmd: list[str]) -> tuple[float, float, float]:
     return seconds, after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime, load
 
 
+def phases(json_out: str | None) -> int:
+    """Run ``info`` and the report (HTML + PDF) once each (after an unmeasured run) through
+    ``phases_hook.py`` and print each stage's start, wall and CPU seconds, per process."""
+    hook = [sys.executable, str(REPO / "benchmarks" / "phases_hook.py")]
+    result = {}
+    with tempfile.TemporaryDirectory() as out:
+        for c in commands(out):
+            if c["name"] not in ("gcodekit info", "gcodekit report (HTML + PDF)"):
+                continue
+            cmd = hook + c["cmd"][3:]  # the command's arguments after ``python -m gcodekit.cli``
+            records = Path(out, "phases.jsonl")
+            run_once(cmd)
+            records.unlink(missing_ok=True)
+            ENV["GCODEKIT_PHASES"] = str(records)
+            try:
+                seconds, cpu, load = run_once(cmd)
+            finally:
+                del ENV["GCODEKIT_PHASES"]
+            rows = [json.loads(line) for line in records.read_text().splitlines()]
+            result[c["name"]] = {"seconds": seconds, "cpu_s": cpu, "load": load, "stages": rows}
+            print(f"\n{c['name']} ({c['file']}): {seconds:.2f} s wall, {cpu:.2f} CPU-s with its children "
+                  f"(Chromium's included), load average {load:.1f}")
+            print(f"  {'process':14}{'stage':44}{'calls':>6}{'first at s':>11}{'wall s':>9}{'CPU s':>8}")
+            stages: dict[tuple[str, str], list[dict]] = {}
+            for r in rows:
+                stages.setdefault((r["process"], r["stage"]), []).append(r)
+            for (who, stage), calls in sorted(stages.items(), key=lambda kv: kv[1][0]["start_s"]):
+                print(f"  {who.split()[0]:14}{stage:44}{len(calls):6d}{calls[0]['start_s']:11.2f}"
+                      f"{sum(r['wall_s'] for r in calls):9.2f}{sum(r['cpu_s'] for r in calls):8.2f}")
+    if json_out:
+        Path(json_out).write_text(json.dumps(result, indent=2) + "\n")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeat", type=int, default=5, help="runs of each command, best counts (default: 5)")
@@ -93,11 +128,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", metavar="OUT", help="also write the figures as JSON")
     p.add_argument("--checkout", type=Path, metavar="DIR",
                    help="measure the gcodekit of another checkout (say, main's, for a before and after)")
+    p.add_argument("--phases", action="store_true",
+                   help="instead: run info and the report (HTML + PDF) once each with their stages timed")
     args = p.parse_args(argv)
     if args.checkout:
         ENV["PYTHONPATH"] = str(args.checkout.resolve())
     if not CYLINDER.exists():
         sys.exit(f"corpus not found: {CORPUS}")
+    if args.phases:
+        return phases(args.json)
     repeat = 2 if args.quick else args.repeat
     with tempfile.TemporaryDirectory() as out:
         cmds = commands(out)
