@@ -29,6 +29,7 @@ from ..schema import allocate
 from ..units import MM_PER_INCH, mm_per
 from . import arcs
 from .handlers import Context
+from .fill import forward_fill
 from .ini import LinuxCncIni
 from .modal import ModalHandler, Waypoint
 from .presets import MachineConfig
@@ -258,8 +259,10 @@ class Machine:
                       position: np.ndarray) -> None:
         """A probe towards or away from the part (G38.2, G38.4) must go somewhere: rs274 refuses
         one that starts at its target; G38.3 and G38.5, which need no contact, may."""
-        probes = np.flatnonzero(moving & (t.name[start:start + moving.size] == NAME_ID["probe"])
-                                & np.isin(t.number[start:start + moving.size], (382, 384)))
+        probing = moving & (t.name[start:start + moving.size] == NAME_ID["probe"])
+        if not probing.any():
+            return
+        probes = np.flatnonzero(probing & np.isin(t.number[start:start + moving.size], (382, 384)))
         for i in probes[np.all(np.abs(position[probes] - start_pos[probes]) < 1e-9, axis=1)].tolist():
             self.diagnostics.report(int(t.line[start + i]), 1, "Start point too close to probe point", kind="machine")
 
@@ -319,7 +322,7 @@ class Machine:
             if s.incremental:
                 targets[:, ax] = program[ax] + np.cumsum(np.nan_to_num(values))
             else:
-                targets[:, ax] = _forward_fill(values, program[ax])
+                targets[:, ax] = forward_fill(values, program[ax])
         position = s.to_machine(targets)
         if s.program_shift.any():  # until the first move the machine stays where it is
             waiting = np.cumsum(moving) == 0
@@ -338,7 +341,7 @@ class Machine:
         if s.feed_mode == "inverse_time":
             feed = feed_words  # 1/min, for this block only
         else:
-            feed = _forward_fill(feed_words, s.feed)
+            feed = forward_fill(feed_words, s.feed)
         if not s.feed_given:
             self._note_boot_feed(t, rows, feed_words, motion, position - start_pos)
 
@@ -382,7 +385,7 @@ class Machine:
         if s.feed_mode == "per_minute":
             s.feed = float(feed[-1])
         elif s.feed_mode == "per_rev":
-            s.feed = float(_forward_fill(feed_words, s.feed)[-1])
+            s.feed = float(forward_fill(feed_words, s.feed)[-1])
         s.speed = float(speed[-1])
 
     def _reject_radius_arcs(self, t: CommandTable, rows: slice, moving: np.ndarray) -> None:
@@ -405,7 +408,7 @@ class Machine:
             de = np.nan_to_num(e)
             s.e_program += float(de.sum())
         else:
-            target = _forward_fill(e, s.e_program)
+            target = forward_fill(e, s.e_program)
             de = np.diff(target, prepend=s.e_program)
             s.e_program = float(target[-1])
         de *= s.flow
@@ -417,7 +420,7 @@ class Machine:
             return np.full(rows.stop - rows.start, self.state.speed)
         words = _dense(t.params["S"], rows).copy()
         words[~in_ids(kind, _MILL)] = np.nan
-        return _forward_fill(words, self.state.speed)
+        return forward_fill(words, self.state.speed)
 
     def _arcs(self, t, start, idx, start_pos, end_pos, centers, distance) -> None:
         """Centres (machine coordinates) and lengths of the arc rows ``idx`` (relative to ``start``).
@@ -593,13 +596,6 @@ def _take(t: CommandTable, letter: str, rows: np.ndarray) -> np.ndarray:
     if col is None:
         return np.full(rows.size, np.nan)
     return col[rows] if isinstance(col, np.ndarray) else t.param_at(letter, rows)
-
-
-def _forward_fill(values: np.ndarray, initial: float) -> np.ndarray:
-    """Each NaN replaced by the last number before it (``initial`` at the start)."""
-    idx = np.where(np.isnan(values), -1, np.arange(values.size))
-    np.maximum.accumulate(idx, out=idx)
-    return np.where(idx >= 0, values[np.maximum(idx, 0)], initial)
 
 
 def _constants_as_views(out: dict) -> dict:

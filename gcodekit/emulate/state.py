@@ -102,8 +102,10 @@ class MachineState:
 
     def to_machine(self, program: np.ndarray) -> np.ndarray:
         """Program coordinates (one point or rows of points, mm) in machine coordinates."""
-        turned = rotate_xy(np.asarray(program, float) + self.g92, self.rotation)
-        return turned + self.frame + self.tool_offset
+        turned = rotate_xy(np.asarray(program, float) + self.g92, self.rotation)  # a new array either way
+        turned += self.frame
+        turned += self.tool_offset
+        return turned
 
     def to_program(self, machine: np.ndarray) -> np.ndarray:
         """Machine coordinates (one point or rows of points) in program coordinates, mm."""

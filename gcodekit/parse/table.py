@@ -51,10 +51,10 @@ def in_ids(values: np.ndarray, ids) -> np.ndarray:
     costs about a twentieth of a fancy-indexed lookup); more are looked up
     in a table with ``take`` (a third of the cost of ``lut[values]``).
     """
-    ids = np.unique(np.asarray(ids, np.int64))
+    ids = np.asarray(ids, np.int64)
     if ids.size <= _COMPARED_IDS:
         out = np.zeros(np.shape(values), bool)
-        for i in ids.tolist():
+        for i in set(ids.ravel().tolist()):
             out |= values == i
         return out
     lut = np.zeros(256, bool)
