@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from .flavor import DetectRules, Flavor
 from .loader import list_flavors, load_flavor
@@ -145,6 +145,15 @@ class _Evidence:
     suffix: str
     e_words: bool = False  # E words on moves (see _e_words_on_moves)
     moves: int = 0  # move lines in the head (see _MOVE_LINE)
+    found: dict[tuple[str, bool], bool] = field(default_factory=dict, compare=False)
+
+    def matches(self, pattern: re.Pattern[str], bare: bool = False) -> bool:
+        """Whether ``pattern`` occurs in the head (``bare``: without comments), searched once for all the
+        flavors whose rules share it (five printer flavors' ``against`` tool change, for one)."""
+        key = (pattern.pattern, bare)
+        if key not in self.found:
+            self.found[key] = pattern.search(self.bare if bare else self.head) is not None
+        return self.found[key]
 
 
 def _e_words_on_moves(bare: str) -> bool:
@@ -160,15 +169,15 @@ def _score(rules: DetectRules, evidence: _Evidence) -> tuple[float, list[str]]:
     """Points of one flavor's rules against the evidence, and why (see :func:`detect_flavor`)."""
     score, reasons = 0.0, []
     for pattern in rules.header:
-        if pattern.search(evidence.head):
+        if evidence.matches(pattern):
             score += HEADER_POINTS
             reasons.append(f"header matches /{pattern.pattern}/")
     for pattern in rules.against:
-        if pattern.search(evidence.head):
+        if evidence.matches(pattern):
             score -= AGAINST_POINTS
             reasons.append(f"against: text matches /{pattern.pattern}/")
     for pattern in rules.hints:
-        if pattern.search(evidence.bare):
+        if evidence.matches(pattern, bare=True):
             score += HINT_POINTS
             reasons.append(f"code matches /{pattern.pattern}/")
     suffix = evidence.suffix
