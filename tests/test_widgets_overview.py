@@ -23,7 +23,8 @@ from gcodekit.widgets import LayerViewer, VelocityPlot  # noqa: E402
 from gcodekit.widgets.layer_viewer import SEGMENT_BYTES  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-CUBE = ROOT.parent / "shared" / "corpus" / "fff" / "cube20_marlin2.gcode"
+CORPUS = ROOT.parent / "shared" / "corpus" / "fff"
+CUBE = CORPUS / "cube20_marlin2.gcode"
 
 
 @pytest.fixture(scope="module")
@@ -172,6 +173,32 @@ def test_raster_picture_agrees_with_matplotlib(cube, monkeypatch):
     # buffer keeps the nearest sample, matplotlib blends antialiased lines in painter's order)
     assert whole.iou > 0.9, whole
     assert one.iou > 0.8 and one.median_angle < 8 and one.within_10 > 0.85, one
+
+
+@pytest.mark.parametrize("program, chunk", [(None, 1000), (CORPUS / "cylinder_marlin2.gcode", 400_000)])
+def test_raster_engines_draw_the_same_picture(cube, monkeypatch, program, chunk):
+    """The compiled pixel loop and the NumPy raster give the same image to the bit (ties: the last sample)."""
+    from gcodekit.view import Camera
+    from gcodekit.widgets import picture, raster_kernel
+
+    kernel = raster_kernel.compiled()
+    if kernel is None:
+        pytest.skip("Numba is not installed: the NumPy raster alone")
+    if program is not None and not program.is_file():
+        pytest.skip(f"{program.name} is not in the shared corpus")
+    op = cube if program is None else gcodekit.gcode_to_operation(program)
+    path = Toolpath.of(op)
+    color = coloring(path, "speed")
+    monkeypatch.setattr(picture, "RASTER_CHUNK", chunk)  # several chunks share the depth buffer (the cube)
+    images = []
+    for chosen in (None, kernel):
+        monkeypatch.setattr(raster_kernel, "engine", lambda n, chosen=chosen: chosen)
+        fig = picture.new_figure((640, 480))
+        ax = fig.add_axes((0.0, 0.0, 0.78, 1.0))
+        picture.raster_toolpath(ax, path, color, Camera(), np.arange(path.n_segments))
+        images.append(np.asarray(ax.images[0].get_array()))
+    assert (images[0] != 1.0).any(axis=2).sum() > 1000  # something drawn
+    assert images[0].tobytes() == images[1].tobytes()
 
 
 def test_plot_names_the_toolpaths_moves_and_shares_the_viewers_path(cube):

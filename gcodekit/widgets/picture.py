@@ -8,7 +8,8 @@ PNG every widget puts in its rich display so an exported notebook shows it
 offline.  matplotlib draws about ten thousand segments a second here, so
 more than :data:`RASTER_FROM` segments are drawn as the WebGL view draws
 them, one pixel wide with a depth buffer, by :func:`raster_toolpath` in
-NumPy, and shown as an image in the same figure.
+NumPy (its pixel loop compiled when Numba is installed:
+:mod:`.raster_kernel`), and shown as an image in the same figure.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..view import Camera
+from . import raster_kernel
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -107,6 +109,7 @@ def raster_toolpath(ax, path: "Toolpath", color: "Coloring", camera: Camera,
     rgb, vmin, vmax = color.segment_rgb(path, segments)
     image = np.ones((height, width, 3))
     depth = np.full(height * width, -np.inf)
+    kernel = raster_kernel.engine(segments.size)
     for c in range(0, segments.size, RASTER_CHUNK):
         keep = segments[c:c + RASTER_CHUNK]
         ends = [(path.start[keep] - centre), (path.end[keep] - centre)]
@@ -116,6 +119,10 @@ def raster_toolpath(ax, path: "Toolpath", color: "Coloring", camera: Camera,
         near = [p @ eye for p in ends]
         count = np.clip(np.ceil(np.maximum(np.abs(cols[1] - cols[0]), np.abs(rows[1] - rows[0]))), 1, 4 * width) + 1
         count = count.astype(np.int64)
+        if kernel is not None:  # the same samples as below, as one compiled loop
+            kernel(*cols, *rows, *near, count, np.ascontiguousarray(rgb[c:c + RASTER_CHUNK]), width, height,
+                   image.reshape(-1, 3), depth)
+            continue
         seg = np.repeat(np.arange(keep.size), count)
         t = (np.arange(seg.size) - np.repeat(np.cumsum(count) - count, count)) / (count - 1)[seg]
         x = np.floor(cols[0][seg] + t * (cols[1] - cols[0])[seg]).astype(np.int64)
