@@ -15,7 +15,10 @@ makes ``LayerViewer(op)`` and ``VelocityPlot(op).link(viewer)`` and
 displays them.  *Open* is the time from that clock reading to the first
 frame the browser shows of each widget (an observer in the page stamps the
 view's status label when the first picture is drawn, and the animation frame
-after it); both clocks are this machine's.  *Bytes* are the kernel's
+after it); both clocks are this machine's.  The kernel's wall and CPU
+time (its threads included) for each widget and for the display, and the
+load average, are printed beside: the machine is shared, and its load shows
+in the wall times.  *Bytes* are the kernel's
 websocket frames the page receives: while the cell runs (the widgets'
 state, their PNGs) and during the steps (layers sent on demand).
 
@@ -47,6 +50,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import statistics
 import sys
@@ -105,14 +109,16 @@ PROBE = """() => {
 }"""
 
 #: The second cell: the clock read, the widgets made and shown, the kernel's own times printed.
-OPEN_CELL = """import time
-t0 = time.time()
+OPEN_CELL = """import os, time
+load = os.getloadavg()[0]
+t0, c0 = time.time(), time.process_time()
 viewer = LayerViewer(op)
-t1 = time.time()
+t1, c1 = time.time(), time.process_time()
 plot = VelocityPlot(op).link(viewer)
-t2 = time.time()
+t2, c2 = time.time(), time.process_time()
 display(viewer, plot)
-print(f"gk-times {t0:.3f} {t1 - t0:.3f} {t2 - t1:.3f} {time.time() - t2:.3f}")"""
+t3, c3 = time.time(), time.process_time()
+print(f"gk-times {t0:.3f} {t1 - t0:.3f} {t2 - t1:.3f} {t3 - t2:.3f} {c1 - c0:.3f} {c2 - c1:.3f} {c3 - c2:.3f} {load:.2f}")"""
 
 
 def notebook(program: Path, out: Path) -> None:
@@ -167,9 +173,11 @@ def browser_steps(program: Path, steps: int, pause_ms: int) -> dict:
             page.wait_for_timeout(1000)
             opened = page.evaluate("window.gkOpen")
             times = page.locator(".jp-OutputArea-output:has-text('gk-times')").inner_text().split()
-            t0, kernel = float(times[1]), [float(v) for v in times[2:5]]
+            t0, kernel = float(times[1]), [float(v) for v in times[2:9]]
             result = {"open_viewer_s": opened["viewerShown"] / 1000 - t0, "open_plot_s": opened["plotShown"] / 1000 - t0,
                       "kernel_viewer_s": kernel[0], "kernel_plot_s": kernel[1], "kernel_display_s": kernel[2],
+                      "kernel_viewer_cpu_s": kernel[3], "kernel_plot_cpu_s": kernel[4], "kernel_display_cpu_s": kernel[5],
+                      "load_at_open": kernel[6],
                       "open_bytes": traffic.bytes - marks["start"]}
             page.evaluate(PROBE)
             before_steps = traffic.bytes
@@ -210,7 +218,8 @@ def report(program: Path, r: dict, png: list[float]) -> bool:
     print(f"{program.name}: {len(r['drawn'])} steps, {r['segments']} segments drawn at the end")
     print(f"  open: first picture of LayerViewer {r['open_viewer_s']:.2f} s, of VelocityPlot {r['open_plot_s']:.2f} s "
           f"after the cell started (kernel: viewer {r['kernel_viewer_s']:.2f} s, plot {r['kernel_plot_s']:.2f} s, "
-          f"display {r['kernel_display_s']:.2f} s)")
+          f"display {r['kernel_display_s']:.2f} s; CPU {r['kernel_viewer_cpu_s']:.2f}, {r['kernel_plot_cpu_s']:.2f} "
+          f"and {r['kernel_display_cpu_s']:.2f} s, threads included; load average {r['load_at_open']:.1f})")
     print(f"  bytes received from the kernel: {r['open_bytes'] / 1e6:.2f} MB while the cell ran, "
           f"{r['step_bytes'] / 1e6:.2f} MB during the steps")
     for k, label in (("drawn", "key press to draw call"), ("shown", "key press to the frame shown"),
@@ -249,7 +258,11 @@ def main(argv=None) -> int:
     print(f"import gcodekit: {(time.perf_counter() - t0) * 1000:.0f} ms")
     failed, figures = False, []
     for program in args.files:
+        load_before = os.getloadavg()[0]
         r = browser_steps(program, args.steps, args.pause)
+        r["load_before"], r["load_after"] = load_before, os.getloadavg()[0]
+        print(f"load average {load_before:.1f} before, {r['load_after']:.1f} after (2 CPUs shared: wall times grow "
+              "with it; the kernel's CPU times less)")
         png = peer_png(program, args.peer_steps) if args.peer_steps else []
         ok = report(program, r, png)
         failed |= not ok

@@ -30,7 +30,7 @@ from ..read.source import ProgramLines
 from ..view import Camera, Coloring, Toolpath, ToolpathError, choices, coloring, overview
 from .cell import after_cell
 from .display import PictureDisplay, friendly, message_html
-from .picture import message_figure, toolpath_figure
+from .picture import import_in_background, message_figure, toolpath_figure
 from .toolpath import load_toolpath
 
 #: Source lines shown around the current one.
@@ -123,6 +123,7 @@ class LayerViewer(PictureDisplay):
                  show_travel: bool = False, height: int = 480, max_segments: int = MAX_SEGMENTS):
         self.error: str | None = None
         self.max_segments = max(int(max_segments), 1)
+        import_in_background()  # the display's PNG needs matplotlib: loaded while this widget is built
         self.details_sent = 0
         self.path: Toolpath | None = None
         self.camera = Camera()

@@ -15,6 +15,8 @@ NumPy (its pixel loop compiled when Numba is installed:
 from __future__ import annotations
 
 import io
+import sys
+import threading
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +34,25 @@ DPI = 100
 RASTER_FROM = 20_000
 #: Segments rasterised at a time (bounds the memory of the samples along them).
 RASTER_CHUNK = 400_000
+
+
+def import_in_background() -> None:
+    """Start importing matplotlib's figure and Agg canvas on a thread, if not imported yet.
+
+    A widget's display draws its PNG with them (importing them costs about
+    0.7 CPU-s); a widget starts this when it is made, so the import runs
+    beside the NumPy work that builds the widget (which releases the GIL)
+    rather than after it.  Python's import lock makes a later ``import``
+    wait for this one to finish.
+    """
+    if "matplotlib.backends.backend_agg" in sys.modules:
+        return
+
+    def load() -> None:
+        import matplotlib.backends.backend_agg  # noqa: F401
+        import matplotlib.figure  # noqa: F401
+
+    threading.Thread(target=load, name="gcodekit-matplotlib-import", daemon=True).start()
 
 
 def new_figure(size: tuple[int, int]) -> "Figure":

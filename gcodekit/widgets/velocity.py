@@ -22,7 +22,7 @@ import traitlets
 
 from ..view import Toolpath, ToolpathError, move_rows, source_lines
 from .display import PictureDisplay, friendly, message_html
-from .picture import message_figure, new_figure
+from .picture import import_in_background, message_figure, new_figure
 from .toolpath import load_source
 
 #: Bins of the envelope: about one per pixel of a notebook-wide plot.
@@ -80,6 +80,7 @@ class VelocityPlot(PictureDisplay):
         from ..errors import check_choice
 
         check_choice("x", x, tuple(X_LABELS))
+        import_in_background()  # the display's PNG needs matplotlib: loaded while this widget is built
         self.x_name = x
         self.error: str | None = None
         self.source = None
