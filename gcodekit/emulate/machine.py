@@ -311,7 +311,9 @@ class Machine:
         motion = np.where(moving, t.motion[rows], 0).astype(np.uint8)
         scale = s.scale()
         program = s.program_position()
-        targets = np.empty((n, 6))  # program coordinates, mm
+        # program coordinates, mm, stored axis by axis: each axis is filled and offset as one contiguous
+        # column (NumPy's passes over rows of six are several times slower), same values either way
+        targets = np.empty((6, n)).T
         for ax, letter in enumerate(AXES):
             col = t.params.get(letter)
             if col is None:
@@ -346,7 +348,7 @@ class Machine:
             self._note_boot_feed(t, rows, feed_words, motion, position - start_pos)
 
         de = self._extrusion(t, rows, moving)
-        delta = position - start_pos
+        delta = np.subtract(position, start_pos, order="C")  # row by row, as einsum has always summed it
         distance = np.sqrt(np.einsum("ij,ij->i", delta[:, :3], delta[:, :3]))
         centers = np.full((n, 3), np.nan)
         is_arc = (motion == MOTION_CW) | (motion == MOTION_CCW)
@@ -367,7 +369,8 @@ class Machine:
         # G93 gives each move a time (1/F minutes); like rs274, report the speed that makes it, over the
         # length from where rs274 takes the tool to be (after an offset change it may not be there yet)
         if s.feed_mode == "inverse_time":
-            steps = np.linalg.norm((targets - np.vstack([program[None, :], targets[:-1]]))[:, :3], axis=1)
+            steps = np.linalg.norm(np.subtract(targets, np.vstack([program[None, :], targets[:-1]]), order="C")[:, :3],
+                                   axis=1)
             length = np.where(is_arc, distance, steps)
             out["feed"][rows] = feed * np.where(length > 0, length, rotary)
         else:
