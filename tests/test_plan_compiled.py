@@ -127,3 +127,21 @@ def test_auto_engine_by_size():
     with pytest.raises(ValueError):
         with kernels.using("fortran"):
             pass
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(*[st.sampled_from([0.0, 1.0, 2.0, 4.0, 9.0, 1e-12, np.inf])] * 5, st.booleans()),
+                min_size=1, max_size=30))
+def test_klipper_cruise_agrees(rows):
+    from gcodekit.plan import klipper
+
+    start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2 = (np.array(c, float) for c in list(zip(*rows))[:5])
+    flush = np.array([r[5] for r in rows])
+    flush[0] = True
+    m = {"delta_v2": delta_v2, "mcr_delta_v2": mcr_delta_v2, "max_cruise_v2": max_cruise_v2}
+    ref = klipper._cruise(start_v2, mcr_start_v2, m, flush)
+    got = kernels.compiled().klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush,
+                                            klipper.TIE)
+    assert_bits_equal(ref[0], got[0], "cruise_v2")
+    assert_bits_equal(ref[1], got[1], "next_start_v2")

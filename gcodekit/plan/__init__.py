@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import ConfigError, did_you_mean
 from .moves import PlannedMoves, PlannerMoves, PlanResult
+from .trapezoids import TrapezoidPlan
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -71,7 +72,7 @@ class Plan:
 
     time: np.ndarray
     moves: PlannedMoves
-    result: PlanResult
+    result: PlanResult | TrapezoidPlan
 
 
 def run_planner(program: "EmulatedProgram", name: str, settings) -> Plan:
@@ -92,8 +93,7 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
     planner's crawl at its minimum speed.
     """
     n = w["x"].size
-    duration_t = result.accel_t + result.cruise_t  # duration_t, summed in place: one array fewer at the peak
-    duration_t += result.decel_t
+    duration_t = result.duration_t
     # (np.bincount of no moves gives integers, whatever the weights)
     times = np.bincount(moves.waypoint, weights=duration_t, minlength=n).astype(np.float64, copy=False)
     del duration_t
@@ -113,6 +113,7 @@ def waypoint_speeds(plan: tuple[PlannedMoves, PlanResult], n: int) -> dict[str, 
     moves, result = plan
     out = {k: np.zeros(n) for k in ("start_v", "cruise_v", "end_v", "accel")}
     if len(moves):
+        result = result.phases()  # every field in one computation
         first = np.r_[True, moves.waypoint[1:] != moves.waypoint[:-1]]
         last = np.r_[moves.waypoint[1:] != moves.waypoint[:-1], True]
         out["start_v"][moves.waypoint[first]] = result.start_v[first]

@@ -44,7 +44,8 @@ def compiled() -> SimpleNamespace | None:
         return None
     jit = numba.njit(cache=True, nogil=True)
     return SimpleNamespace(forward_min=jit(_forward_min), backward_min=jit(_backward_min),
-                           classic_jerk=jit(_classic_jerk), klipper_moves=jit(_klipper_moves))
+                           classic_jerk=jit(_classic_jerk), klipper_moves=jit(_klipper_moves),
+                           klipper_cruise=jit(_klipper_cruise))
 
 
 def engine(n_moves: int) -> SimpleNamespace | None:
@@ -333,3 +334,57 @@ def _klipper_moves(start, end, speed_v, row, flush, limit_rows, max_velocity, ma
         mcr_delta_v2_out[i] = mcr_delta_v2
         p_kinematic, p_e_r, p_r0, p_r1, p_r2, p_jd = kinematic, e_r, r0, r1, r2, jd
     return move_d_out, accel_out, max_cruise_v2_out, delta_v2_out, mcr_delta_v2_out, cap_out, junction
+
+
+def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush, tie_r):
+    """:func:`.klipper._cruise`: each move's cruise speed squared and the next move's start.
+
+    A backward pass finds, for each move, the nearest move at or after it in
+    the same flush that sets a peak (``next_marked``); a forward pass keeps
+    the running minimum of a move that cannot accelerate (``segmented_cummin``,
+    whose minimum is the earliest of equal values, as here).
+    """
+    n = start_v2.size
+    cruise_v2 = np.empty(n)
+    next_start_v2 = np.empty(n)
+    can_accel = np.empty(n, np.bool_)
+    has_next = False  # a peak-setting move at or after i in i's flush
+    peak = 0.0
+    for i in range(n - 1, -1, -1):
+        last_of_segment = i == n - 1 or flush[i + 1]
+        if last_of_segment:
+            next_start = next_mcr = 0.0
+            has_next = False  # the next flush's peaks are not this one's
+        else:
+            next_start, next_mcr = start_v2[i + 1], mcr_start_v2[i + 1]
+        next_start_v2[i] = next_start
+        reach = next_mcr + mcr_delta_v2[i]
+        tie = tie_r * (reach if (reach > 1.0 or reach != reach) else 1.0)
+        accel = mcr_start_v2[i] < reach - tie
+        can_accel[i] = accel
+        pending = not last_of_segment and not can_accel[i + 1]
+        if accel and (mcr_start_v2[i] + mcr_delta_v2[i] > next_mcr + tie or pending):
+            has_next = True
+            peak = (mcr_start_v2[i] + reach) * 0.5
+        c = ((next_start + delta_v2[i]) + start_v2[i]) * 0.5
+        b = max_cruise_v2[i]
+        if not (c < b or c != c):
+            c = b
+        b = peak if has_next else 0.0
+        if not (c < b or c != c):
+            c = b
+        cruise_v2[i] = c
+    acc = 0.0
+    for i in range(n):
+        if can_accel[i]:
+            seed = cruise_v2[i]
+        elif flush[i]:
+            seed = 0.0
+        else:
+            seed = start_v2[i]
+        if can_accel[i] or flush[i] or i == 0:
+            acc = seed
+        elif seed < acc or seed != seed:  # np.minimum(seed, acc): the earlier on a tie
+            acc = seed
+        cruise_v2[i] = acc
+    return cruise_v2, next_start_v2

@@ -27,6 +27,7 @@ from ..memory import release_freed_memory
 from .kernels import engine
 from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
+from .trapezoids import TrapezoidPlan
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -197,7 +198,8 @@ def _velocity_limits(op: "EmulatedProgram", config: KlipperConfig):
 BLOCK = 1 << 14
 
 
-def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | PlannedMoves,
+                                                              PlanResult | TrapezoidPlan]:
     """Plan an emulated operation as Klipper would; one result per firmware move."""
     factor = speed_factor(op)
     # gcode_arcs.py: chords of at most `resolution` mm
@@ -235,7 +237,11 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
     start_v2 = backward_min(max_start_v2, m["delta_v2"])
     mcr_start_v2 = backward_min(max_mcr_start_v2, m["mcr_delta_v2"])
     del max_start_v2, max_mcr_start_v2
-    cruise_v2, next_start_v2 = _cruise(start_v2, mcr_start_v2, m, flush)
+    if compiled is not None:
+        cruise_v2, next_start_v2 = compiled.klipper_cruise(start_v2, mcr_start_v2, m["delta_v2"], m["mcr_delta_v2"],
+                                                           m["max_cruise_v2"], flush, TIE)
+    else:
+        cruise_v2, next_start_v2 = _cruise(start_v2, mcr_start_v2, m, flush)
     del mcr_start_v2, m["max_cruise_v2"], m["delta_v2"], m["mcr_delta_v2"]  # free before the trapezoids
     release_freed_memory()
     return planned, _set_junction(start_v2, cruise_v2, next_start_v2, m)
@@ -384,22 +390,13 @@ def _cruise(start_v2, mcr_start_v2, m, flush):
     return segmented_cummin(seed, chain), next_start_v2
 
 
-def _set_junction(start_v2, cruise_v2, next_start_v2, m) -> PlanResult:
-    """Move.set_junction: the trapezoid of each move (in blocks: fewer temporaries at once).
-
-    The speeds are written over ``start_v2``, ``cruise_v2`` and
-    ``next_start_v2`` (a block after it is read), which the caller drops.
-    """
-    n = start_v2.size
-    result = PlanResult(start_v2, cruise_v2, next_start_v2, m["accel"], np.empty(n), np.empty(n), np.empty(n))
-    for lo in range(0, n, BLOCK):
-        sl = slice(lo, min(lo + BLOCK, n))
-        _set_junction_block(start_v2[sl], cruise_v2[sl], next_start_v2[sl], m["accel"][sl], m["move_d"][sl],
-                            result, sl)
-    return result
+def _set_junction(start_v2, cruise_v2, next_start_v2, m) -> TrapezoidPlan:
+    """Move.set_junction: the trapezoid of each move, computed when read (:class:`.trapezoids.TrapezoidPlan`)."""
+    return TrapezoidPlan(_set_junction_block, m["move_d"], m["accel"], start_v2, cruise_v2, next_start_v2)
 
 
-def _set_junction_block(start_v2, cruise_v2, next_start_v2, accel, move_d, result: PlanResult, sl: slice) -> None:
+def _set_junction_block(move_d, accel, start_v2, cruise_v2, next_start_v2, result: PlanResult, sl: slice) -> None:
+    """Move.set_junction for one block of moves, into ``result``'s arrays at ``sl``."""
     start_v2 = np.minimum(start_v2, cruise_v2)
     end_v2 = np.minimum(next_start_v2, cruise_v2)
     half_inv_accel = 0.5 / accel

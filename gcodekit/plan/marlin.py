@@ -40,9 +40,10 @@ import numpy as np
 from ..errors import ConfigError
 from ..memory import release_freed_memory
 from .kernels import engine
-from .lookahead import BLOCK, empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
+from .lookahead import BLOCK, _trapezoid_block, empty_result, limit_by_axis_maximum, lookahead, unit_vectors
 from .moves import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before,
                     StepSetting, m204_in_force, settings_in_force, speed_factor)
+from .trapezoids import TrapezoidPlan
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -273,7 +274,7 @@ def _program_limits(op: "EmulatedProgram", moves: PlannerMoves, config: MarlinCo
     return limits
 
 
-def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult]:
+def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | PlannedMoves, PlanResult | TrapezoidPlan]:
     """Plan an emulated operation as Marlin 2 would; one result per firmware move.
 
     Examples
@@ -316,8 +317,9 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
                                                 rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
     del block, delta_v2, nominal_length, rest_after
     release_freed_memory()  # the passes' temporaries, before the trapezoids' arrays
-    return planned, trapezoid(millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr, exit_speed_sqr,
-                              reuse=True)
+    # the trapezoids are computed when read (TrapezoidPlan): three arrays fewer kept
+    return planned, TrapezoidPlan(_trapezoid_block, millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr,
+                                  exit_speed_sqr)
 
 
 def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, config: MarlinConfig,

@@ -106,7 +106,14 @@ class PlanResult:
 
     @property
     def duration_t(self) -> np.ndarray:
-        return self.accel_t + self.cruise_t + self.decel_t
+        duration_t = self.accel_t + self.cruise_t
+        duration_t += self.decel_t  # in place: one array fewer
+        return duration_t
+
+    def phases(self, sel: slice | np.ndarray = slice(None)) -> "PlanResult":
+        """The moves ``sel`` (a slice or indices); see :meth:`.trapezoids.TrapezoidPlan.phases`."""
+        return PlanResult(*(getattr(self, f)[sel] for f in ("start_v", "cruise_v", "end_v", "accel", "accel_t",
+                                                              "cruise_t", "decel_t")))
 
 
 def command_rows(op: "EmulatedProgram", *, names: tuple[str, ...] = (), codes: tuple[str, ...] = ()) -> np.ndarray:

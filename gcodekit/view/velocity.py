@@ -108,7 +108,7 @@ class VelocityMoves:
         if self.op.plan is None:
             lo[:] = hi[:] = self.commanded()
             return lo, hi
-        r = self.result
+        r = self.result.phases()  # the speeds in one computation (a planner may compute them when read)
         np.minimum(np.minimum(r.start_v, r.cruise_v, out=lo), r.end_v, out=lo)
         np.maximum(np.maximum(r.start_v, r.cruise_v, out=hi), r.end_v, out=hi)
         return lo, hi
@@ -125,11 +125,14 @@ class VelocityMoves:
     def corners_of(self, moves: slice | np.ndarray, columns: tuple[str, ...] = COLUMNS) -> dict[str, np.ndarray]:
         """The corners of ``moves`` (a slice or indices), as (k, ``per_move``) rows flattened, per column."""
         out = {}
+        needs_plan = self.op.plan is not None and bool(set(columns) - {"line", "commanded"})
+        planned = self.result.phases(moves) if needs_plan else None  # every planned field in one computation
         for name in columns:
-            out[name] = self._column(name, moves).ravel()
+            out[name] = self._column(name, moves, planned).ravel()
         return out
 
-    def _column(self, name: str, sel: slice | np.ndarray) -> np.ndarray:
+    def _column(self, name: str, sel: slice | np.ndarray, r=None) -> np.ndarray:
+        """Column ``name`` of the moves ``sel``; ``r``: their planned phases (``self.result.phases(sel)``)."""
         if name == "line":
             return np.repeat(self.line[sel], self.per_move)
         if self.op.plan is None:
@@ -140,21 +143,20 @@ class VelocityMoves:
                 d0, d_end = self._distance
                 return np.column_stack([d0[sel], d_end[sel]])
             return np.repeat(self.commanded()[sel], 2)  # planned and commanded: the feed, held
-        r = self.result
         if name == "time":
             t0, dur = self._time
-            t0, accel_t = t0[sel], r.accel_t[sel]
-            return np.column_stack([t0, t0 + accel_t, t0 + accel_t + r.cruise_t[sel], t0 + dur[sel]])
+            t0, accel_t = t0[sel], r.accel_t
+            return np.column_stack([t0, t0 + accel_t, t0 + accel_t + r.cruise_t, t0 + dur[sel]])
         if name == "distance":
             d0, d = self._distance
-            d0, d, accel = d0[sel], d[sel], r.accel[sel]
-            start_v, cruise_v, end_v = r.start_v[sel], r.cruise_v[sel], r.end_v[sel]
+            d0, d, accel = d0[sel], d[sel], r.accel
+            start_v, cruise_v, end_v = r.start_v, r.cruise_v, r.end_v
             accel_d = (cruise_v**2 - start_v**2) / (2 * accel)
             decel_d = (cruise_v**2 - end_v**2) / (2 * accel)
             return np.column_stack([d0, d0 + accel_d, d0 + d - decel_d, d0 + d])
         if name == "planned":
-            cruise_v = r.cruise_v[sel]
-            return np.column_stack([r.start_v[sel], cruise_v, cruise_v, r.end_v[sel]])
+            cruise_v = r.cruise_v
+            return np.column_stack([r.start_v, cruise_v, cruise_v, r.end_v])
         if name == "commanded":
             return np.repeat(self.moves.speed_v[sel], 4)
         raise ValueError(f"no corner column {name!r}: choose from {', '.join(COLUMNS)}")

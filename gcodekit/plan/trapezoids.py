@@ -1,0 +1,105 @@
+"""Plan stage: a plan's per-move speeds and phase times, computed when read.
+
+A planner's passes decide three squared speeds per move (entry, the speed
+it may cruise at, exit); each move's trapezoid then follows from them, its
+length and its acceleration.  :class:`TrapezoidPlan` keeps those inputs
+and computes the speeds and phase times (:class:`.moves.PlanResult`'s
+fields) a block at a time when they are read, with the planner's own block
+function, so they come out the same to the last bit: a planned program
+keeps four arrays per move instead of seven.  Read several fields at once
+with :meth:`TrapezoidPlan.phases` (each field read alone computes the
+trapezoids again).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from .moves import PlanResult
+
+__all__ = ["TrapezoidPlan", "FIELDS"]
+
+#: The fields computed on reading (``accel`` is kept).
+FIELDS = ("start_v", "cruise_v", "end_v", "accel_t", "cruise_t", "decel_t")
+BLOCK = 1 << 14  # moves computed at once: small temporaries
+
+#: ``shape(move_d, accel, a_v2, b_v2, c_v2, out, sl)`` writes ``out.<field>[sl]`` for one block of moves.
+Shape = Callable[..., None]
+
+
+class _Discard:
+    """Where a block's unwanted fields go."""
+
+    def __setitem__(self, key, value) -> None:
+        pass
+
+
+class TrapezoidPlan:
+    """:class:`.moves.PlanResult`'s arrays, computed from the squared speeds when read.
+
+    Parameters
+    ----------
+    shape : callable
+        The planner's block function (see :data:`Shape`).
+    move_d, accel : ndarray
+        Each move's length (mm) and acceleration (mm/s^2).
+    *v2 : ndarray
+        The three squared speeds ``shape`` takes, mm^2/s^2.
+    """
+
+    def __init__(self, shape: Shape, move_d: np.ndarray, accel: np.ndarray, *v2: np.ndarray):
+        self._shape, self._move_d, self.accel, self._v2 = shape, move_d, accel, v2
+
+    def __len__(self) -> int:
+        return int(self._move_d.size)
+
+    def phases(self, sel: slice | np.ndarray = slice(None)) -> PlanResult:
+        """Every field of the moves ``sel`` (a slice or indices), computed once."""
+        return self._compute(FIELDS, sel)
+
+    def _compute(self, fields: tuple[str, ...], sel: slice | np.ndarray = slice(None)) -> PlanResult:
+        move_d, accel = self._move_d[sel], self.accel[sel]
+        v2 = [a[sel] for a in self._v2]
+        n = move_d.size
+        out = PlanResult(**{f: np.empty(n) if f in fields else _Discard() for f in FIELDS}, accel=accel)
+        for lo in range(0, n, BLOCK):
+            s = slice(lo, min(lo + BLOCK, n))
+            self._shape(move_d[s], accel[s], *(a[s] for a in v2), out, s)
+        return out
+
+    @property
+    def start_v(self) -> np.ndarray:
+        return self._compute(("start_v",)).start_v
+
+    @property
+    def cruise_v(self) -> np.ndarray:
+        return self._compute(("cruise_v",)).cruise_v
+
+    @property
+    def end_v(self) -> np.ndarray:
+        return self._compute(("end_v",)).end_v
+
+    @property
+    def accel_t(self) -> np.ndarray:
+        return self._compute(("accel_t",)).accel_t
+
+    @property
+    def cruise_t(self) -> np.ndarray:
+        return self._compute(("cruise_t",)).cruise_t
+
+    @property
+    def decel_t(self) -> np.ndarray:
+        return self._compute(("decel_t",)).decel_t
+
+    @property
+    def duration_t(self) -> np.ndarray:
+        """Each move's time, s: ``accel_t + cruise_t + decel_t``, summed a block at a time."""
+        n = len(self)
+        out = np.empty(n)
+        for lo in range(0, n, BLOCK):
+            s = slice(lo, min(lo + BLOCK, n))
+            r = self._compute(("accel_t", "cruise_t", "decel_t"), s)
+            out[s] = r.accel_t + r.cruise_t + r.decel_t
+        return out
