@@ -204,11 +204,11 @@ class Toolpath:
         lo, hi = self.bounds()
         return (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 1e-3)
 
-    def times(self) -> tuple[np.ndarray, np.ndarray]:
-        """Start and end time (s) of every move."""
-        w = self.op.waypoints
-        end = self.op.elapsed_time()[self.move_rows]
-        return end - np.nan_to_num(np.asarray(w["time"], float)[self.move_rows]), end
+    def times(self, moves: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
+        """Start and end time (s) of every move, or of ``moves`` (indices of :attr:`move_rows`)."""
+        rows = self.move_rows[moves]
+        end = self.op.elapsed_time()[rows]
+        return end - np.nan_to_num(np.asarray(self.op.waypoints["time"], float)[rows]), end
 
 
 def _corners(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

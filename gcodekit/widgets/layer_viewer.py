@@ -356,8 +356,10 @@ class LayerViewer(PictureDisplay):
         first, last = self._chords
         p = self.path
         move_of = p.move_of[first]
+        move_seg = np.zeros(p.move_rows.size + 1, np.int64)  # each move's first chord: the chords before it counted
+        np.cumsum(np.bincount(move_of, minlength=p.move_rows.size), out=move_seg[1:])
         chords = dataclasses.replace(p, start=p.start[first], end=p.end[last], move_of=move_of, kind=p.kind[first],
-                                     move_seg=np.searchsorted(move_of, np.arange(p.move_rows.size + 1)))
+                                     move_seg=move_seg)
         return chords, dataclasses.replace(self._coloring, values=self._coloring.values[first])
 
     def __repr__(self) -> str:

@@ -85,7 +85,6 @@ class VelocityPlot(PictureDisplay):
         self.error: str | None = None
         self.source = None
         self._path: Toolpath | None = None
-        self._move_times: tuple[np.ndarray, np.ndarray] | None = None
         self._linked = None
         self.view = VelocityView(height=height, x_label=X_LABELS[x], layout=widgets.Layout(width="100%"))
         self.picked = widgets.HTML()
@@ -226,10 +225,8 @@ class VelocityPlot(PictureDisplay):
 
     def show_moves(self, first: int, last: int) -> None:
         """Show the moves ``first..last`` (indices of the toolpath's moves)."""
-        if self._move_times is None:  # a slider step asks again: the toolpath's times once
-            self._move_times = self.path.times()
-        start, end = self._move_times
-        t0, t1 = start[first], end[last]
+        start, end = self.path.times(np.array([first, last]))  # two moves' times, not every move's
+        t0, t1 = start[0], end[1]
         if self.x_name == "distance":
             t0, t1 = self._distance_at(np.array([t0, t1]))
         self.show(t0, t1)
