@@ -335,11 +335,7 @@ class GcodeParser:
                 name[i] = NAME_ID.get(self.flavor.codes.get(part.named[0].upper(), ""), 0)
         self._report_unknown(t, name)
 
-        sets = np.full(n, _KEEP, np.uint8)
-        for mname, mode in _MOTION_MODES.items():
-            sets[name == NAME_ID[mname]] = mode
-        sets[(name == NAME_ID["cancel_cycle"]) | (name == NAME_ID["nurbs_end"])] = MOTION_NONE
-        sets[in_ids(name, self._cycle_ids)] = MOTION_CYCLE
+        sets = _SETS_MOTION.take(name)
         # After a lathe cycle (G70-G72) rs274 is in the mode of the cycle's last move,
         # which only the machine knows: axis words alone stay cycle rows for it to settle
         lathe = in_ids(name, self._lathe_ids)
@@ -382,11 +378,8 @@ class GcodeParser:
         kind[(letter == 0) & has_s & ~has_f] = Kind.MILL
         kind[(letter == 0) & ~(has_f | has_s | has_axes | has_e)] = Kind.COMMENT
         kind[is_motion_name & ~(has_axes | has_e) & has_f] = Kind.FEED_RATE
-        kind[name == NAME_ID["dwell"]] = Kind.DWELL
-        kind[name == NAME_ID["distance_absolute"]] = Kind.ABSOLUTE_POSITION
-        kind[name == NAME_ID["distance_incremental"]] = Kind.INCREMENTAL_POSITION
-        for k in range(1, 10):
-            kind[name == NAME_ID[f"work_offset_{k}"]] = Kind.WORK_COORDINATES
+        named_kind = _KIND_OF_NAME.take(name)
+        kind = np.where(named_kind != _KEEP, named_kind, kind)
         lin = moving & ~arc
         kind[lin] = Kind.MOVE
         kind[lin & has_s & ~has_e] = Kind.MOVE_MILL
@@ -465,6 +458,23 @@ class GcodeParser:
             else:  # firmware add codes freely (M900, M620, ...): say once, quietly, that it does nothing here
                 self.diagnostics.report(line, 1, f"{code} has no meaning in gcodekit's {self.flavor.name} flavor; "
                                         "kept as a command without effect on the path", severity="info")
+
+
+def _by_name(pairs) -> np.ndarray:
+    """A table from name id to value, :data:`_KEEP` for the names not in ``pairs`` (later pairs win)."""
+    table = np.full(256, _KEEP, np.uint8)
+    for name, value in pairs:
+        table[NAME_ID[name]] = value
+    return table
+
+
+#: The motion mode each command name sets (:data:`_KEEP`: none)
+_SETS_MOTION = _by_name([*_MOTION_MODES.items(), ("cancel_cycle", MOTION_NONE), ("nurbs_end", MOTION_NONE),
+                         *((c, MOTION_CYCLE) for c in CYCLE_NAMES)])
+#: The kind a command name gives its row whatever its words (:data:`_KEEP`: decided by the words)
+_KIND_OF_NAME = _by_name([("dwell", Kind.DWELL), ("distance_absolute", Kind.ABSOLUTE_POSITION),
+                          ("distance_incremental", Kind.INCREMENTAL_POSITION),
+                          *((f"work_offset_{k}", Kind.WORK_COORDINATES) for k in range(1, 10))])
 
 
 def _is_code(word_letter: np.ndarray) -> np.ndarray:

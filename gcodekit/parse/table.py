@@ -208,8 +208,9 @@ class CommandTable:
         for letter, col in list(self.params.items()):
             if isinstance(col, SparseColumn):
                 continue
-            rows = np.flatnonzero(~np.isnan(col))
-            if rows.size < _SPARSE_BELOW * n:
+            given = ~np.isnan(col)
+            if np.count_nonzero(given) < _SPARSE_BELOW * n:  # counted first: a dense column's rows are not listed
+                rows = np.flatnonzero(given)
                 self.params[letter] = SparseColumn(rows.astype(np.int64), col[rows], n)
         return self
 
