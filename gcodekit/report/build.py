@@ -25,6 +25,8 @@ import numpy as np
 from ..model.slicer import compare
 
 if TYPE_CHECKING:
+    import pandas as pd
+
     from ..model.operation import Operation
 
 #: Diagnostics listed on a page; the rest are counted (a broken program can have thousands).
@@ -66,12 +68,9 @@ def report_data(op: "Operation", *, transpile: bool = True, cut: bool = True) ->
     if additive:
         by_layer = op.time_by("layer")
         by_layer = by_layer[by_layer.index >= 0]
-        data["layers"] = [{"layer": int(k), "time_s": float(r.time_s), "filament_mm": float(r.filament_mm)}
-                          for k, r in by_layer.iterrows()]
-        marks = op.slicer_layer_times()
-        data["slicer_layers"] = [{"layer": int(k), "layers": int(r.layers), "time_s": float(r.time_s),
-                                  "slicer_time_s": float(r.slicer_time_s), "elapsed_s": float(r.elapsed_s),
-                                  "slicer_elapsed_s": float(r.slicer_elapsed_s)} for k, r in marks.iterrows()]
+        data["layers"] = _rows(by_layer, "layer", time_s=float, filament_mm=float)
+        data["slicer_layers"] = _rows(op.slicer_layer_times(), "layer", layers=int, time_s=float, slicer_time_s=float,
+                                      elapsed_s=float, slicer_elapsed_s=float)
     if transpile and summary["process"] == "subtractive":
         from ..transpile import Transpiler
 
@@ -95,12 +94,21 @@ def breakdown(op: "Operation") -> dict[str, Any]:
     by = "feature" if np.any(op.features != "") else "tool"
     table = op.time_by(by)
     table = table[(table["time_s"] > 0) | (table["distance_mm"] > 0)]
-    rows = []
-    for key, r in table.iterrows():
-        label = (str(key) or "(before the first feature)") if by == "feature" else f"T{int(key)}"
-        rows.append({"label": label, "time_s": float(r.time_s), "distance_mm": float(r.distance_mm),
-                     "extrude_mm": float(r.extrude_mm)})
+    rows = _rows(table, "label", time_s=float, distance_mm=float, extrude_mm=float)
+    for r in rows:
+        r["label"] = (str(r["label"]) or "(before the first feature)") if by == "feature" else f"T{int(r['label'])}"
     return {"by": by, "rows": rows}
+
+
+def _rows(table: "pd.DataFrame", index: str, **columns: type) -> list[dict[str, Any]]:
+    """Each row of ``table`` as a dict of plain numbers: its index under the name ``index`` (an int for the
+    layers), then ``columns`` converted by their types.  Read column by column: ``iterrows`` builds a
+    Series per row, most of the report's numbers' time."""
+    keys = table.index.tolist()
+    if index == "layer":
+        keys = [int(k) for k in keys]
+    values = [[kind(v) for v in table[name].tolist()] for name, kind in columns.items()]
+    return [{index: k, **dict(zip(columns, row))} for k, *row in zip(keys, *values)]
 
 
 def key_figures(data: dict[str, Any]) -> dict[str, Any]:
