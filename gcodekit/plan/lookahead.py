@@ -34,7 +34,8 @@ def limit_by_axis_maximum(max_value, unit_vec) -> np.ndarray:
 
 
 def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.ndarray, *,
-              rest_v2: float = 0.0, nominal_length: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+              rest_v2: float = 0.0, nominal_length: np.ndarray | None = None,
+              reuse: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Entry and exit speeds (squared) after the reverse and forward passes.
 
     Parameters
@@ -51,6 +52,9 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     nominal_length : ndarray of bool, optional
         Marlin's ``nominal_length`` flag: such a move always enters at its
         cap, and the next move's entry is not checked against it.
+    reuse : bool, default: False
+        Write the reverse pass's bounds over ``max_entry_v2`` (a float64
+        array the caller no longer needs): one array fewer at the peak.
 
     Returns
     -------
@@ -73,9 +77,13 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     free = rest_after.copy()
     if nominal_length is not None:
         free |= nominal_length
-    bound = np.where(rest_after, np.minimum(max_entry_v2, rest_v2 + delta_v2), max_entry_v2)
-    if nominal_length is not None:
-        bound = np.where(nominal_length, max_entry_v2, bound)
+    stop = rest_after if nominal_length is None else rest_after & ~nominal_length  # a nominal_length move: its cap
+    if reuse and isinstance(max_entry_v2, np.ndarray) and max_entry_v2.dtype == np.float64:
+        bound = max_entry_v2
+        np.minimum(bound, rest_v2 + delta_v2, out=bound, where=stop)
+    else:
+        bound = np.where(stop, np.minimum(max_entry_v2, rest_v2 + delta_v2), max_entry_v2)
+    del stop
     reverse_v2 = backward_min(bound, np.where(free, bound, delta_v2))
     del bound  # each array dropped as soon as it is used: the plan of a large program is memory-bound
     forward_inc = delta_v2.copy()

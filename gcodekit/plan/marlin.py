@@ -302,19 +302,21 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     for lo in range(0, n, BLOCK):
         _populate_blocks(moves, lim, rest_before, config, lo, min(lo + BLOCK, n), block, compiled)
     del lim
-    millimeters, acceleration, nominal_speed = block["millimeters"], block["acceleration"], block["nominal_speed"]
+    millimeters, acceleration = block["millimeters"], block["acceleration"]
     planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, millimeters)
     del moves  # the end points are no longer needed: free them before the passes
     release_freed_memory()
     minimum_planner_speed_sqr = config.minimum_planner_speed**2
     delta_v2 = 2.0 * acceleration * millimeters
-    nominal_speed_sqr = nominal_speed * nominal_speed
+    nominal_speed_sqr = block.pop("nominal_speed")
+    nominal_speed_sqr *= nominal_speed_sqr  # squared in place: one array fewer
     # "If a block can de/ac-celerate from nominal speed to zero within the length of the block, then the
     # current block and next block junction speeds are guaranteed to always be at their maximum"
     nominal_length = nominal_speed_sqr <= minimum_planner_speed_sqr + delta_v2
     rest_after = np.r_[rest_before[1:], True]
     entry_speed_sqr, exit_speed_sqr = lookahead(block["max_entry_speed_sqr"], delta_v2, rest_after,
-                                                rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length)
+                                                rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length,
+                                                reuse=True)
     del block, delta_v2, nominal_length, rest_after
     release_freed_memory()  # the passes' temporaries, before the trapezoids' arrays
     # the trapezoids are computed when read (TrapezoidPlan): three arrays fewer kept
