@@ -36,7 +36,7 @@ class Column:
 #: Columns that say which command made a waypoint; the machine writes ``command``, the DataFrames the rest.
 COMMAND_COLUMNS: tuple[Column, ...] = (
     Column("line", "", "int32", "source line of the command (1-based, in the file the user gave)"),
-    Column("command", "", "int64", "row in op.commands of the command that made the waypoint"),
+    Column("command", "", "int32", "row in op.commands of the command that made the waypoint"),
     Column("code", "", "str", "the command's code as written (G1, M104, a named command's name)"),
     Column("kind", "", "category", "the command's kind (motion, setting, ...)"),
 )
@@ -96,5 +96,5 @@ def allocate(n: int) -> dict[str, np.ndarray]:
     """Empty arrays for ``n`` waypoints, one per :data:`WAYPOINT_COLUMNS` entry, in order, and
     ``command``: at first one waypoint per command."""
     out = {c.name: np.empty(n, c.dtype) for c in WAYPOINT_COLUMNS}
-    out["command"] = np.arange(n, dtype=np.int64)
+    out["command"] = np.arange(n, dtype=np.int32)
     return out

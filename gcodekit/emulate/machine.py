@@ -618,7 +618,7 @@ def _with_extra_waypoints(out: dict, extra: list, n: int) -> dict:
     rows = np.array([r for r, _ in extra])
     for key, arr in out.items():
         if key == "command":
-            out[key] = np.insert(arr, rows, rows).astype(np.int64)
+            out[key] = np.insert(arr, rows, rows).astype(np.int32)
             continue
         values = [w.values.get(key, arr[r]) if r < n else 0 for r, w in extra]
         out[key] = np.insert(arr, rows, np.array(values, dtype=arr.dtype))

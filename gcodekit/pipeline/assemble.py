@@ -35,7 +35,7 @@ def concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarra
         return parts[0]
     shift = np.cumsum([0] + sizes[:-1])
     for p, s in zip(parts, shift):  # each chunk counts its commands from 0
-        p["command"] = p["command"] + s
+        p["command"] = p["command"] + np.int32(s)  # int32: max_motions keeps the rows far below 2**31
     out = {}
     for key in list(parts[0]):
         cols = [p.pop(key) for p in parts]
