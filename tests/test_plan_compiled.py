@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 import gcodekit
 from gcodekit.plan import kernels, marlin, planner_settings, run_planner, scans
+from gcodekit.plan import moves as moves_module
 
 if kernels.compiled() is None:
     pytest.skip("Numba is not installed (pip install 'gcodekit[fast]')", allow_module_level=True)
@@ -145,3 +146,19 @@ def test_klipper_cruise_agrees(rows):
                                             klipper.TIE)
     assert_bits_equal(ref[0], got[0], "cruise_v2")
     assert_bits_equal(ref[1], got[1], "next_start_v2")
+
+
+def test_move_points_agree():
+    # homing, a zero-length move, an extruder-only move, a full circle, a position jump (G92) and NaN-free floats
+    text = ("G28\nG1 X0 Y0 F600\nG1 X10 E1\nG1 X10\nG1 E2\nG92 X0\nG1 X5 E3\nG2 X5 Y0 I1 J0\nG1 X-0 Y-0\n"
+            "G28 X\nG1 X3 Y3\nG1 Z0.3\n")
+    for planner in ("marlin", "klipper"):
+        op = gcodekit.gcode_to_operation(text, planner, plan=False)
+        out = []
+        for name in ("numpy", "numba"):
+            with kernels.using(name):
+                out.append(moves_module.firmware_moves(op))
+        ref, got = out
+        for field in ("start", "end", "speed_v", "row", "waypoint"):
+            assert_bits_equal(getattr(ref, field), getattr(got, field), field)
+        assert np.shares_memory(ref.start, ref.end) == np.shares_memory(got.start, got.end)

@@ -45,7 +45,7 @@ def compiled() -> SimpleNamespace | None:
     jit = numba.njit(cache=True, nogil=True)
     return SimpleNamespace(forward_min=jit(_forward_min), backward_min=jit(_backward_min),
                            classic_jerk=jit(_classic_jerk), klipper_moves=jit(_klipper_moves),
-                           klipper_cruise=jit(_klipper_cruise))
+                           klipper_cruise=jit(_klipper_cruise), move_points=jit(_move_points))
 
 
 def engine(n_moves: int) -> SimpleNamespace | None:
@@ -388,3 +388,53 @@ def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v
             acc = seed
         cruise_v2[i] = acc
     return cruise_v2, next_start_v2
+
+
+def _move_points(x, y, z, de, motion, homing, distance):
+    """:func:`.moves.firmware_moves`' choice of moves and :func:`.moves._move_ends`' points, in two passes.
+
+    A waypoint is a move when it moves (``motion > 0``), is no homing move,
+    and changes X, Y, Z or the extruder position (the running sum of ``de``,
+    as ``np.cumsum``) or is a full circle.  Returns the moves' waypoints, and
+    their start and end points: rows of one array of points when each move
+    starts where the one before ended (``chained``), else two arrays.
+    """
+    n = x.size
+    is_move = np.zeros(n, np.bool_)
+    count = 0
+    chained = True
+    e = 0.0
+    px = py = pz = pe = 0.0  # the waypoint before
+    lx = ly = lz = le = 0.0  # the last move's end
+    for i in range(n):
+        e = de[i] if i == 0 else e + de[i]
+        if i == 0:
+            changed = x[i] != 0 or y[i] != 0 or z[i] != 0 or e != 0
+        else:
+            changed = x[i] != px or y[i] != py or z[i] != pz or e != pe
+        if motion[i] > 0 and not homing[i] and (changed or (motion[i] >= 3 and distance[i] > 0)):
+            if count > 0 and not (px == lx and py == ly and pz == lz and pe == le):
+                chained = False  # this move does not start where the last one ended
+            is_move[i] = True
+            count += 1
+            lx, ly, lz, le = x[i], y[i], z[i], e
+        px, py, pz, pe = x[i], y[i], z[i], e
+    idx = np.empty(count, np.int64)
+    start = np.empty((count + 1 if chained else count, 4))
+    end = start[1:] if chained else np.empty((count, 4))
+    k = 0
+    e = 0.0
+    px = py = pz = pe = 0.0
+    for i in range(n):
+        e = de[i] if i == 0 else e + de[i]
+        if is_move[i]:
+            idx[k] = i
+            if k == 0 or not chained:
+                if i == 0:
+                    start[k, 0] = start[k, 1] = start[k, 2] = start[k, 3] = 0.0
+                else:
+                    start[k, 0], start[k, 1], start[k, 2], start[k, 3] = px, py, pz, pe
+            end[k, 0], end[k, 1], end[k, 2], end[k, 3] = x[i], y[i], z[i], e
+            k += 1
+        px, py, pz, pe = x[i], y[i], z[i], e
+    return idx, (start[:count] if chained else start), end, chained

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..emulate import arcs
 from ..parse.table import NAME_ID
+from .kernels import engine
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -265,21 +266,27 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     """
     w = op.waypoints
     n = w["x"].size
-    e = np.cumsum(w["de"])
-    columns = (w["x"], w["y"], w["z"], e)
     rows = w["command"]
     # Homing moves go to an endstop from wherever the axis really is: their
     # length and time are unknown, and firmware time estimates leave them out.
     homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
-    changed = np.zeros(n, bool)
-    for col in columns:  # compare with the previous waypoint column by column
-        changed[:1] |= col[:1] != 0
-        changed[1:] |= col[1:] != col[:-1]
-    full_circle = (w["motion"] >= 3) & (w["distance"] > 0)  # ends where it started
-    idx = _narrow(np.flatnonzero((w["motion"] > 0) & ~homing & (changed | full_circle)), n)
-    del changed
-    start, end = _move_ends(columns, idx)
-    del e, columns
+    compiled = engine(n)
+    if compiled is not None:  # the same moves and points in one loop, without the temporaries below
+        idx, start, end, _ = compiled.move_points(w["x"], w["y"], w["z"], w["de"], w["motion"], homing, w["distance"])
+        idx = _narrow(idx, n)
+    else:
+        e = np.cumsum(w["de"])
+        columns = (w["x"], w["y"], w["z"], e)
+        changed = np.zeros(n, bool)
+        for col in columns:  # compare with the previous waypoint column by column
+            changed[:1] |= col[:1] != 0
+            changed[1:] |= col[1:] != col[:-1]
+        full_circle = (w["motion"] >= 3) & (w["distance"] > 0)  # ends where it started
+        idx = _narrow(np.flatnonzero((w["motion"] > 0) & ~homing & (changed | full_circle)), n)
+        del changed
+        start, end = _move_ends(columns, idx)
+        del e, columns
+    del homing
     speed = np.asarray(w["feed"], float)[idx] / 60.0
     if speed_factor is not None:
         speed *= speed_factor[idx]
