@@ -3,8 +3,9 @@
 One module per job: :mod:`.build` computes the numbers, :mod:`.figures` draws
 the pictures (matplotlib, off-screen), :mod:`.html` renders the pages
 (Jinja2), :mod:`.pdf` prints them with headless Chromium, :mod:`.batch` runs
-many programs on worker processes or a Dask cluster and :mod:`.notebook`
-writes the same report as an executed notebook.  Nothing heavy is imported
+many programs on worker processes or a Dask cluster, :mod:`.forked` draws
+some of one program's pictures in a forked child (a second core) and
+:mod:`.notebook` writes the same report as an executed notebook.  Nothing heavy is imported
 until a report is made (the batch module
 included).
 
