@@ -153,7 +153,7 @@ function render({ model, el }) {
     ? { key: "", work: null, points: [], width: 0, height: 0 } : null;
   const state = { nSeg: 0, values: new Float32Array(0), kinds: new Uint8Array(0), segMove: new Int32Array(0),
     groupSeg: new Int32Array(1), groupMove: new Int32Array(1), moveLimit: null, frame: 0, pending: false, ncat: 0,
-    width: 400, drawn: "", version: 0 };
+    width: 0, drawn: "", version: 0 }; // width 0: not laid out yet (the ResizeObserver tells)
 
   function attribute(name, buffer, size) {
     const index = gl.getAttribLocation(program, name);
@@ -318,6 +318,9 @@ function render({ model, el }) {
 
   function draw() {
     state.pending = false;
+    // before the first layout the width is unknown: a picture drawn at a guessed width was drawn again at
+    // the real one a frame later (1-2 s each for a large program on a software renderer)
+    if (state.width === 0) return;
     const s = span();
     const camera = model.get("camera");
     const ratio = window.devicePixelRatio || 1;
