@@ -217,7 +217,7 @@ def velocity(op: "Operation", bins: int = 1500, window_s: float = 20.0) -> "Figu
     """
     from ..analysis import velocity_corners  # arrays: a DataFrame of a 3 M-line print's corners costs seconds
 
-    v = velocity_corners(op)
+    v = velocity_corners(op, columns=("time", "distance", "planned", "commanded"))  # not the source lines
     if v["time"].size == 0:
         return None
     t, planned, commanded = (np.asarray(v[c], float) for c in ("time", "planned", "commanded"))
