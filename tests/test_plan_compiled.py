@@ -36,20 +36,34 @@ def assert_bits_equal(a, b, what: str) -> None:
         assert np.array_equal(a, b), what
 
 
+FIELDS = ("start_v", "cruise_v", "end_v", "accel", "accel_t", "cruise_t", "decel_t")
+
+
 def plan_both(op, planner: str, config):
+    """The plan by each engine, with its fields read (a plan may compute them when read) by the same engine."""
     out = []
     for name in ("numpy", "numba"):
         with kernels.using(name):
-            out.append(run_planner(op, planner, config))
+            plan = run_planner(op, planner, config)
+            r = plan.result
+            single = {f: getattr(r, f) for f in FIELDS}  # each read alone
+            some = r.phases(slice(1, None, 2)) if len(r) else None
+            out.append((plan, r.phases(), single, r.duration_t, some))
     return out
 
 
 def assert_same_plan(ref, got) -> None:
-    assert_bits_equal(ref.time, got.time, "waypoint time")
+    (ref_plan, ref_all, ref_single, ref_duration, ref_some), (plan, every, single, duration, some) = ref, got
+    assert_bits_equal(ref_plan.time, plan.time, "waypoint time")
     for field in ("speed_v", "row", "waypoint", "length_d"):
-        assert_bits_equal(getattr(ref.moves, field), getattr(got.moves, field), field)
-    for field in ("start_v", "cruise_v", "end_v", "accel", "accel_t", "cruise_t", "decel_t"):
-        assert_bits_equal(getattr(ref.result, field), getattr(got.result, field), field)
+        assert_bits_equal(getattr(ref_plan.moves, field), getattr(plan.moves, field), field)
+    for field in FIELDS:
+        assert_bits_equal(getattr(ref_all, field), getattr(every, field), field)
+        assert_bits_equal(ref_single[field], single[field], field + " read alone")
+        assert_bits_equal(ref_single[field], getattr(every, field), field + " read alone and with the others")
+        if some is not None:
+            assert_bits_equal(getattr(ref_some, field), getattr(some, field), field + " of some moves")
+    assert_bits_equal(ref_duration, duration, "duration_t")
 
 
 def corpus(name: str) -> Path:
@@ -162,3 +176,29 @@ def test_move_points_agree():
         for field in ("start", "end", "speed_v", "row", "waypoint"):
             assert_bits_equal(getattr(ref, field), getattr(got, field), field)
         assert np.shares_memory(ref.start, ref.end) == np.shares_memory(got.start, got.end)
+
+
+trapezoid_v2 = st.one_of(st.floats(0.0, 1e5), st.sampled_from([0.0, 1.0, 4.0, 25.0, 1e-300, np.inf]))
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from([0.0, 1e-9, 0.5, 1.0, 2.0, 10.0]),
+                          st.sampled_from([0.0, 500.0, 3000.0, np.inf]), trapezoid_v2, trapezoid_v2, trapezoid_v2),
+                min_size=1, max_size=20),
+       st.sampled_from(["marlin", "klipper"]))
+def test_trapezoids_agree(rows, planner):
+    from gcodekit.plan import klipper, lookahead
+    from gcodekit.plan.trapezoids import TrapezoidPlan
+
+    move_d, accel, a, b, c = (np.array(col, float) for col in zip(*rows))
+    shape, kernel = ((lookahead._trapezoid_block, "marlin_trapezoids") if planner == "marlin"
+                     else (klipper._set_junction_block, "klipper_trapezoids"))
+    plan = TrapezoidPlan(shape, move_d, accel, a, b, c, kernel=kernel)
+    with kernels.using("numpy"):
+        ref, ref_duration = plan.phases(), plan.duration_t
+    with kernels.using("numba"):
+        got, duration = plan.phases(), plan.duration_t
+    for field in FIELDS:
+        assert_bits_equal(getattr(ref, field), getattr(got, field), field)
+    assert_bits_equal(ref_duration, duration, "duration_t")

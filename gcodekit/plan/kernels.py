@@ -42,10 +42,12 @@ def compiled() -> SimpleNamespace | None:
         import numba
     except ImportError:
         return None
-    jit = numba.njit(cache=True, nogil=True)
+    # error_model="numpy": a division by zero gives inf or NaN, as in the NumPy code, instead of raising
+    jit = numba.njit(cache=True, nogil=True, error_model="numpy")
     return SimpleNamespace(forward_min=jit(_forward_min), backward_min=jit(_backward_min),
                            classic_jerk=jit(_classic_jerk), klipper_moves=jit(_klipper_moves),
-                           klipper_cruise=jit(_klipper_cruise), move_points=jit(_move_points))
+                           klipper_cruise=jit(_klipper_cruise), move_points=jit(_move_points),
+                           marlin_trapezoids=jit(_marlin_trapezoids), klipper_trapezoids=jit(_klipper_trapezoids))
 
 
 def engine(n_moves: int) -> SimpleNamespace | None:
@@ -438,3 +440,76 @@ def _move_points(x, y, z, de, motion, homing, distance):
             k += 1
         px, py, pz, pe = x[i], y[i], z[i], e
     return idx, (start[:count] if chained else start), end, chained
+
+
+def _marlin_trapezoids(move_d, accel, entry_v2, nominal_v2, exit_v2, start_v, cruise_v, end_v, accel_t, cruise_t,
+                       decel_t, duration_t):
+    """:func:`.lookahead._trapezoid_block` move by move.
+
+    The outputs are the speeds (all three or none, by ``start_v``'s size),
+    the phase times (likewise) and their sums; an output of size 0 is not
+    computed.
+    """
+    for i in range(move_d.size):
+        d, a, entry, nominal, exit_ = move_d[i], accel[i], entry_v2[i], nominal_v2[i], exit_v2[i]
+        half_inv_accel = 0.5 / a
+        accel_d = (nominal - entry) * half_inv_accel
+        decel_d = (nominal - exit_) * half_inv_accel
+        short = accel_d + decel_d > d
+        meet_d = (d + (exit_ - entry) * half_inv_accel) * 0.5
+        if meet_d == meet_d:  # np.clip(meet_d, 0.0, d): NumPy's maximum, then minimum, NaN kept
+            meet_d = meet_d if meet_d > 0.0 else 0.0
+            meet_d = meet_d if (meet_d < d or meet_d != meet_d) else d
+        if short:
+            accel_d = meet_d
+            cruise_v2 = entry + 2.0 * a * meet_d
+        else:
+            accel_d = accel_d if (accel_d > 0.0 or accel_d != accel_d) else 0.0
+            cruise_v2 = nominal
+        start_v2 = entry if (entry < nominal or entry != entry) else nominal
+        if not (start_v2 < cruise_v2 or start_v2 != start_v2):
+            start_v2 = cruise_v2
+        if short:
+            decel_d = d - meet_d
+        elif decel_d == decel_d:  # np.clip(decel_d, 0.0, d - accel_d)
+            decel_d = decel_d if decel_d > 0.0 else 0.0
+            hi = d - accel_d
+            decel_d = decel_d if (decel_d < hi or decel_d != decel_d) else hi
+        end_v2 = cruise_v2 - 2.0 * a * decel_d
+        end_v2 = end_v2 if (end_v2 > 0.0 or end_v2 != end_v2) else 0.0
+        cruise_d = d - accel_d - decel_d
+        cruise_d = cruise_d if (cruise_d > 0.0 or cruise_d != cruise_d) else 0.0
+        sv, cv, ev = np.sqrt(start_v2), np.sqrt(cruise_v2), np.sqrt(end_v2)
+        at = (cv - sv) / a if accel_d > 0 else 0.0
+        ct = cruise_d / cv if cruise_d > 0 else 0.0
+        dt = (cv - ev) / a if decel_d > 0 else 0.0
+        if start_v.size:
+            start_v[i], cruise_v[i], end_v[i] = sv, cv, ev
+        if accel_t.size:
+            accel_t[i], cruise_t[i], decel_t[i] = at, ct, dt
+        if duration_t.size:
+            duration_t[i] = at + ct + dt
+
+
+def _klipper_trapezoids(move_d, accel, start_v2, cruise_v2, next_start_v2, start_v, cruise_v, end_v, accel_t,
+                        cruise_t, decel_t, duration_t):
+    """:func:`.klipper._set_junction_block` move by move, into the outputs as :func:`_marlin_trapezoids`."""
+    for i in range(move_d.size):
+        a, c2 = accel[i], cruise_v2[i]
+        s2 = start_v2[i] if (start_v2[i] < c2 or start_v2[i] != start_v2[i]) else c2
+        e2 = next_start_v2[i] if (next_start_v2[i] < c2 or next_start_v2[i] != next_start_v2[i]) else c2
+        half_inv_accel = 0.5 / a
+        accel_d = (c2 - s2) * half_inv_accel
+        decel_d = (c2 - e2) * half_inv_accel
+        cruise_d = move_d[i] - accel_d - decel_d
+        sv, cv, ev = np.sqrt(s2), np.sqrt(c2), np.sqrt(e2)
+        at = accel_d / ((sv + cv) * 0.5) if accel_d > 0 else 0.0
+        ct = cruise_d / cv if cruise_d != 0 else 0.0
+        dt = decel_d / ((ev + cv) * 0.5) if decel_d > 0 else 0.0
+        if start_v.size:
+            start_v[i], cruise_v[i], end_v[i] = sv, cv, ev
+        if accel_t.size:
+            accel_t[i], cruise_t[i], decel_t[i] = at, ct, dt
+        if duration_t.size:
+            duration_t[i] = at + ct + dt
+

@@ -392,7 +392,8 @@ def _cruise(start_v2, mcr_start_v2, m, flush):
 
 def _set_junction(start_v2, cruise_v2, next_start_v2, m) -> TrapezoidPlan:
     """Move.set_junction: the trapezoid of each move, computed when read (:class:`.trapezoids.TrapezoidPlan`)."""
-    return TrapezoidPlan(_set_junction_block, m["move_d"], m["accel"], start_v2, cruise_v2, next_start_v2)
+    return TrapezoidPlan(_set_junction_block, m["move_d"], m["accel"], start_v2, cruise_v2, next_start_v2,
+                         kernel="klipper_trapezoids")
 
 
 def _set_junction_block(move_d, accel, start_v2, cruise_v2, next_start_v2, result: PlanResult, sl: slice) -> None:

@@ -321,7 +321,7 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     release_freed_memory()  # the passes' temporaries, before the trapezoids' arrays
     # the trapezoids are computed when read (TrapezoidPlan): three arrays fewer kept
     return planned, TrapezoidPlan(_trapezoid_block, millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr,
-                                  exit_speed_sqr)
+                                  exit_speed_sqr, kernel="marlin_trapezoids")
 
 
 def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, config: MarlinConfig,

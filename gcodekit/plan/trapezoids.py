@@ -17,6 +17,7 @@ from typing import Callable
 
 import numpy as np
 
+from .kernels import engine
 from .moves import PlanResult
 
 __all__ = ["TrapezoidPlan", "FIELDS"]
@@ -47,10 +48,28 @@ class TrapezoidPlan:
         Each move's length (mm) and acceleration (mm/s^2).
     *v2 : ndarray
         The three squared speeds ``shape`` takes, mm^2/s^2.
+    kernel : str, default: None
+        The name of ``shape``'s compiled loop in :mod:`.kernels`, used when
+        :func:`.kernels.engine` chooses it for a plan this size.
     """
 
-    def __init__(self, shape: Shape, move_d: np.ndarray, accel: np.ndarray, *v2: np.ndarray):
-        self._shape, self._move_d, self.accel, self._v2 = shape, move_d, accel, v2
+    def __init__(self, shape: Shape, move_d: np.ndarray, accel: np.ndarray, *v2: np.ndarray,
+                 kernel: str | None = None):
+        self._shape, self._move_d, self.accel, self._v2, self._kernel = shape, move_d, accel, v2, kernel
+
+    def _compiled(self, sel, fields: tuple[str, ...], duration: bool = False) -> tuple[PlanResult, np.ndarray] | None:
+        """The fields (and the durations) by the compiled loop, or None when the NumPy code is to compute them."""
+        compiled = engine(len(self)) if self._kernel else None
+        if compiled is None:
+            return None
+        move_d, accel = self._move_d[sel], self.accel[sel]
+        n, none = move_d.size, np.empty(0)
+        speeds = [np.empty(n) if any(f in fields for f in FIELDS[:3]) else none for _ in range(3)]
+        times = [np.empty(n) if any(f in fields for f in FIELDS[3:]) else none for _ in range(3)]
+        duration_t = np.empty(n) if duration else none
+        getattr(compiled, self._kernel)(np.ascontiguousarray(move_d), np.ascontiguousarray(accel),
+                                        *(np.ascontiguousarray(a[sel]) for a in self._v2), *speeds, *times, duration_t)
+        return PlanResult(*speeds, accel, *times), duration_t
 
     def __len__(self) -> int:
         return int(self._move_d.size)
@@ -60,6 +79,9 @@ class TrapezoidPlan:
         return self._compute(FIELDS, sel)
 
     def _compute(self, fields: tuple[str, ...], sel: slice | np.ndarray = slice(None)) -> PlanResult:
+        compiled = self._compiled(sel, fields)
+        if compiled is not None:
+            return compiled[0]
         move_d, accel = self._move_d[sel], self.accel[sel]
         v2 = [a[sel] for a in self._v2]
         n = move_d.size
@@ -96,6 +118,9 @@ class TrapezoidPlan:
     @property
     def duration_t(self) -> np.ndarray:
         """Each move's time, s: ``accel_t + cruise_t + decel_t``, summed a block at a time."""
+        compiled = self._compiled(slice(None), (), duration=True)
+        if compiled is not None:
+            return compiled[1]
         n = len(self)
         out = np.empty(n)
         for lo in range(0, n, BLOCK):
