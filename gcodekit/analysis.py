@@ -95,9 +95,11 @@ def slicer_layer_times(op: "Operation", mode: str = "normal") -> "pd.DataFrame":
     columns = ["line", "elapsed_s", "slicer_elapsed_s", "layers", "time_s", "slicer_time_s", "difference_s"]
     rows_of = waypoint_rows(op)
     elapsed, layer = op.elapsed_time(), op.layers
+    # the last waypoint before each mark, searched for all marks at once in the column's own dtype (a Python
+    # int per call made NumPy cast the 3 M commands of plate150 to int64 for each of its 1,431 marks)
+    befores = np.searchsorted(rows_of, np.array([m.row for m in marks], rows_of.dtype), side="left") - 1
     by_layer: dict[int, tuple[int, float, float]] = {}
-    for m in marks:
-        before = int(np.searchsorted(rows_of, m.row, side="left")) - 1  # the last waypoint before the mark
+    for m, before in zip(marks, befores.tolist()):
         if before < 0 or layer[before] < 0:
             continue
         by_layer[int(layer[before])] = (m.line, float(elapsed[before]), m.elapsed_s)
