@@ -47,7 +47,8 @@ def compiled() -> SimpleNamespace | None:
     return SimpleNamespace(forward_min=jit(_forward_min), backward_min=jit(_backward_min),
                            classic_jerk=jit(_classic_jerk), klipper_moves=jit(_klipper_moves),
                            klipper_cruise=jit(_klipper_cruise), move_points=jit(_move_points),
-                           marlin_trapezoids=jit(_marlin_trapezoids), klipper_trapezoids=jit(_klipper_trapezoids))
+                           marlin_trapezoids=jit(_marlin_trapezoids), klipper_trapezoids=jit(_klipper_trapezoids),
+                           marlin_blocks=jit(_marlin_blocks))
 
 
 def engine(n_moves: int) -> SimpleNamespace | None:
@@ -513,3 +514,64 @@ def _klipper_trapezoids(move_d, accel, start_v2, cruise_v2, next_start_v2, start
         if duration_t.size:
             duration_t[i] = at + ct + dt
 
+
+
+def _marlin_blocks(dx, dy, dz, de, speed_v, fx, fy, fz, fe, ax, ay, az, ae, min_feedrate, min_travel_feedrate,
+                   acceleration, travel_acceleration, retract_acceleration, minimum_planner_speed):
+    """:func:`.marlin._populate_blocks`' length, nominal speed, speed per mm and acceleration, move by move.
+
+    Each limit holds one value per move, or one for all (size 1).
+    Returns millimeters, nominal_speed, speed_per_mm and acceleration.
+    """
+    n = dx.size
+    millimeters = np.empty(n)
+    nominal_speed = np.empty(n)
+    speed_per_mm = np.empty(n)
+    accel_out = np.empty(n)
+    big = np.finfo(np.float64).max
+    for i in range(n):
+        d0, d1, d2, d3 = dx[i], dy[i], dz[i], de[i]
+        xyz_moves = d0 != 0 or d1 != 0 or d2 != 0
+        esteps = d3 != 0
+        mm = np.sqrt((d0 * d0 + d1 * d1) + d2 * d2) if xyz_moves else abs(d3)
+        v = speed_v[i]
+        if v != v:  # np.nan_to_num
+            v = 0.0
+        elif v == np.inf:
+            v = big
+        elif v == -np.inf:
+            v = -big
+        b = (min_feedrate[i if min_feedrate.size > 1 else 0] if esteps
+             else min_travel_feedrate[i if min_travel_feedrate.size > 1 else 0])
+        fr = v if (v > b or v != v) else b
+        fr = fr if (fr > minimum_planner_speed or fr != fr) else minimum_planner_speed
+        inverse_millimeters = 1.0 / mm
+        feed_limit = np.inf  # limit_by_axis_maximum of the feed rates
+        accel_limit = np.inf  # and of the accelerations
+        for axis in range(4):
+            if axis == 0:
+                u, f, a = abs(d0), fx, ax
+            elif axis == 1:
+                u, f, a = abs(d1), fy, ay
+            elif axis == 2:
+                u, f, a = abs(d2), fz, az
+            else:
+                u, f, a = abs(d3), fe, ae
+            ratio = f[i if f.size > 1 else 0] / u if u > 0 else np.inf
+            if not (feed_limit < ratio or feed_limit != feed_limit):
+                feed_limit = ratio
+            ratio = a[i if a.size > 1 else 0] / u if u > 0 else np.inf
+            if not (accel_limit < ratio or accel_limit != accel_limit):
+                accel_limit = ratio
+        factor = feed_limit * mm / fr
+        factor = factor if (factor < 1.0 or factor != factor) else 1.0
+        nominal = fr * factor
+        accel = (acceleration[i if acceleration.size > 1 else 0] if esteps
+                 else travel_acceleration[i if travel_acceleration.size > 1 else 0])
+        b = accel_limit * mm
+        accel = accel if (accel < b or accel != accel) else b
+        millimeters[i] = mm
+        nominal_speed[i] = nominal
+        speed_per_mm[i] = nominal * inverse_millimeters
+        accel_out[i] = accel if xyz_moves else retract_acceleration[i if retract_acceleration.size > 1 else 0]
+    return millimeters, nominal_speed, speed_per_mm, accel_out

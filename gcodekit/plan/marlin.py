@@ -327,7 +327,7 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
 def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, config: MarlinConfig,
                      lo: int, hi: int, out: dict, kernels=None) -> None:
     """``_populate_block`` for moves ``lo:hi``: length, nominal speed, acceleration, junction speed
-    (the classic-jerk junctions by the compiled loop of ``kernels``, when given)."""
+    (by the compiled loops of ``kernels`` when given, but for junction deviation's junctions)."""
     first = max(lo - 1, 0)  # the move before the block, for its junction
     sl = slice(first, hi)
     row = moves.row[sl]
@@ -338,9 +338,29 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
 
     xyz_moves = (dist_mm[0] != 0) | (dist_mm[1] != 0) | (dist_mm[2] != 0)
     esteps = dist_mm[3] != 0
+    if kernels is not None:
+        def each(value) -> np.ndarray:  # one value per move, or one for all
+            return np.ascontiguousarray(value, dtype=float).reshape(-1)
+
+        millimeters, nominal_speed, speed_per_mm, acceleration = kernels.marlin_blocks(
+            *dist_mm, np.ascontiguousarray(moves.speed_v[sl]), *map(each, lim["max_feedrate"]),
+            *map(each, lim["max_acceleration"]), *(each(lim[k]) for k in ("min_feedrate", "min_travel_feedrate",
+                                                                        "acceleration", "travel_acceleration",
+                                                                        "retract_acceleration")),
+            float(config.minimum_planner_speed))
+        inverse_millimeters = 1.0 / millimeters
+    else:
+        millimeters, inverse_millimeters, nominal_speed, speed_per_mm, acceleration = _block_speeds(
+            dist_mm, xyz_moves, esteps, moves.speed_v[sl], lim, config)
+    _junctions(dist_mm, esteps, millimeters, inverse_millimeters, nominal_speed, speed_per_mm, acceleration, lim,
+               rest_before[sl], config, kernels, lo - first, lo, hi, out)
+
+
+def _block_speeds(dist_mm, xyz_moves, esteps, speed_v, lim, config):
+    """Length, its inverse, nominal speed, speed per mm and acceleration of a block's moves."""
     xyz_mm, _ = unit_vectors(dist_mm[:3])
     millimeters = np.where(xyz_moves, xyz_mm, np.abs(dist_mm[3]))
-    fr_mm_s = np.maximum(np.nan_to_num(moves.speed_v[sl]),
+    fr_mm_s = np.maximum(np.nan_to_num(speed_v),
                          np.where(esteps, lim["min_feedrate"], lim["min_travel_feedrate"]))
     # no feed rate yet (F0 or none): Marlin only plans positive speeds, so crawl at the stop speed
     fr_mm_s = np.maximum(fr_mm_s, config.minimum_planner_speed)
@@ -355,9 +375,13 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
     accel = np.where(esteps, lim["acceleration"], lim["travel_acceleration"])
     accel = np.minimum(accel, limit_by_axis_maximum(lim["max_acceleration"], dist_mm) * millimeters)
     acceleration = np.where(xyz_moves, accel, lim["retract_acceleration"])
+    return millimeters, inverse_millimeters, nominal_speed, speed_per_mm, acceleration
 
-    rest = rest_before[sl]
-    prev = np.r_[0, np.arange(hi - first - 1)]
+
+def _junctions(dist_mm, esteps, millimeters, inverse_millimeters, nominal_speed, speed_per_mm, acceleration, lim,
+               rest, config, kernels, k, lo, hi, out) -> None:
+    """The junction speeds of a block's moves, and the block's columns into ``out`` (from its ``k``-th move)."""
+    prev = np.r_[0, np.arange(millimeters.size - 1)]
     if config.classic_jerk and kernels is not None:
         max_jerk = [np.ascontiguousarray(j, dtype=float).reshape(-1) for j in lim["max_jerk"]]
         vmax_junction = kernels.classic_jerk(*dist_mm, speed_per_mm, nominal_speed, *max_jerk, rest)
@@ -369,7 +393,6 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
         max_entry_speed_sqr = _junction_deviation(dist_mm, esteps, inverse_millimeters, millimeters, nominal_speed,
                                                   acceleration, lim, prev, config)
         max_entry_speed_sqr[rest] = config.minimum_planner_speed**2
-    k = lo - first
     out["millimeters"][lo:hi] = millimeters[k:]
     out["acceleration"][lo:hi] = acceleration[k:]
     out["nominal_speed"][lo:hi] = nominal_speed[k:]
