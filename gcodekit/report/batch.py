@@ -32,9 +32,22 @@ from ..limits import MAX_ITERATIONS, MAX_MOTIONS
 if TYPE_CHECKING:
     import multiprocessing.context
 
+    from ..model.operation import Operation
+
 #: The pictures a report draws in a forked child (:mod:`.forked`): the toolpath views, about as much CPU
-#: time as the numbers (pandas imported) and the other pictures left to this process (the cylinder's: 1.3 s)
+#: time as the numbers (pandas imported) and the other pictures left to this process (the cylinder's: 1.1 s)
 CHILD_FIGURES = ("iso", "top", "thumbnails")
+#: Commands from which the layer thumbnails are drawn here instead: on large programs the two views alone
+#: outweigh the rest (plate150, 3.1 M commands: the child about 7 CPU-s with the thumbnails against 4.5 here;
+#: they and their PNG take about 1).  On the cylinder (0.15 M) the two sides are even with them in the child.
+THUMBNAILS_HERE_FROM = 1_000_000
+
+
+def child_figures(op: "Operation") -> tuple[str, ...]:
+    """The pictures of ``op``'s report drawn in the forked child, the two sides about even."""
+    if len(op) >= THUMBNAILS_HERE_FROM:
+        return tuple(f for f in CHILD_FIGURES if f != "thumbnails")
+    return CHILD_FIGURES
 
 
 @dataclass(frozen=True)
@@ -118,9 +131,10 @@ def report_program(path: str | os.PathLike, out_dir: str | os.PathLike, name: st
         # the pictures of the operation alone drawn in a forked child (one core more) while this process
         # computes the numbers and draws the rest; the child starts with matplotlib already imported
         load_drawing_modules()
-        drawn_aside = Forked(partial(report_figures, op, None, CHILD_FIGURES))
+        aside = child_figures(op)
+        drawn_aside = Forked(partial(report_figures, op, None, aside))
         data = report_data(op)
-        figures = report_figures(op, data, [f for f in FIGURES if f not in CHILD_FIGURES])
+        figures = report_figures(op, data, [f for f in FIGURES if f not in aside])
         html_path.write_text(program_page(data, {**figures, **drawn_aside.result()}), encoding="utf-8")
         row.update(key_figures(data))
     except Exception as exc:  # noqa: BLE001 -- any failure of one program becomes its error page
