@@ -475,7 +475,7 @@ def _config(root: Path, Config):
 
 
 def _grade(root: Path, student: str, NbGraderAPI, Config) -> None:
-    """In a forked process: nbgrader's autograde and feedback for one student of the course in ``root``."""
+    """In a process of its own: nbgrader's autograde and feedback for one student of the course in ``root``."""
     import sys
 
     api = NbGraderAPI(config=_config(root, Config))
@@ -511,18 +511,20 @@ def _graded_course(root: Path, NbGraderAPI, Config):
                 if any(t.startswith("answer-") for t in tags):
                     cell.source = answer(name, int(tags[0].split("-")[1]), original.source)
             nbformat.write(nb, path)
-    # each student graded in a copy of the course (its own gradebook), the three side by side in processes forked
-    # from this one, which has nbgrader loaded already: each autograde runs nine kernels one after the other
+    # each student graded in a copy of the course (its own gradebook), the three side by side in fresh processes:
+    # each autograde runs nine kernels one after the other.  Spawned, not forked: a fork of this process inherits
+    # the ZeroMQ contexts of the notebook tests run before it, and libzmq aborts in the child
+    # ("Assertion failed: pfd.revents & POLLIN", then "Kernel didn't respond in 60 seconds")
     import multiprocessing
 
     from nbgrader.api import Gradebook
 
-    fork = multiprocessing.get_context("fork")
+    spawn = multiprocessing.get_context("spawn")
     running = {}
     for student in STUDENTS:
         copy = root.parent / f"{root.name}-{student}"
         shutil.copytree(root, copy, ignore=shutil.ignore_patterns(*[s for s in STUDENTS if s != student]))
-        running[student] = copy, fork.Process(target=_grade, args=(copy, student, NbGraderAPI, Config))
+        running[student] = copy, spawn.Process(target=_grade, args=(copy, student, NbGraderAPI, Config))
         running[student][1].start()
     scores = {}
     for student, (copy, process) in running.items():
