@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import io
 import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
 from pathlib import Path
 
 from cli_helpers import run
@@ -114,3 +119,43 @@ def test_version_prints_the_package_version(capsys):
         cli.main(["--version"])
     assert stop.value.code == 0
     assert capsys.readouterr().out.strip() == f"gcodekit {gcodekit.__version__}"
+
+
+def _command(*args, **options) -> subprocess.CompletedProcess:
+    """``gcodekit ARGS`` in a fresh interpreter, through the console script's entry point (:func:`cli.run`)."""
+    return subprocess.run([sys.executable, "-m", "gcodekit.cli", *map(str, args)], capture_output=True, text=True,
+                          **options)
+
+
+def test_the_command_flushes_its_output_and_exits_with_its_status(tmp_path):
+    done = _command("info", PRINT, "--json")
+    assert done.returncode == 0 and json.loads(done.stdout)["file"] == str(PRINT)  # the whole record, flushed
+    bad = tmp_path / "bad.ngc"
+    bad.write_text("G21\nG2 X10 Y0 R1 F100\nM2\n")
+    done = _command("info", bad, "--strict")
+    assert done.returncode == cli.EXIT_PROGRAM_ERROR and f"{bad}:2:" in done.stderr
+    assert _command("--version").stdout.strip().startswith("gcodekit ")  # argparse's own exit
+
+
+def test_a_reader_that_has_gone_gets_no_traceback():
+    with subprocess.Popen([sys.executable, "-m", "gcodekit.cli", "info", MILL, "--json"],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE) as proc:
+        proc.stdout.close()  # gone before the command writes a byte, as ``| true`` is
+        err = proc.stderr.read().decode()
+    assert proc.returncode == 0 and err == ""
+
+
+def test_the_report_command_ends_its_chromium_and_leaves_no_profile(tmp_path):
+    import pytest
+
+    if not shutil.which("chromium"):
+        pytest.skip("chromium not found: apt-get install chromium (scripts/setup.sh does as root)")
+    temp = Path(tempfile.mkdtemp(prefix="t", dir="/tmp"))  # short: the browser's profile is made in it
+    try:
+        done = _command("report", PRINT, "-o", tmp_path / "out", "--no-progress",
+                        env={**os.environ, "TMPDIR": str(temp)})
+        assert done.returncode == 0, done.stderr
+        assert (tmp_path / "out" / f"{PRINT.name}.pdf").stat().st_size > 10_000
+        assert list(temp.iterdir()) == []  # the exit handlers ran: the profile and Chromium's own files are gone
+    finally:
+        shutil.rmtree(temp)

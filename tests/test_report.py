@@ -12,6 +12,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -270,6 +271,58 @@ def test_pages_printed_one_after_another_each_show_their_own_text(tmp_path):
         html_to_pdf(tmp_path / f"p{k}.html", tmp_path / "out.pdf")
         text = subprocess.run([pdftotext, str(tmp_path / "out.pdf"), "-"], capture_output=True, text=True).stdout
         assert text.strip() == f"page {k}"
+
+
+def _live_processes_of_group(group: int) -> list[int]:
+    """The processes of process group ``group`` still running (zombies, dead and not yet reaped, left out)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()  # after the command's name
+        except OSError:  # ended meanwhile
+            continue
+        state, pgrp = fields[0], int(fields[2])
+        if pgrp == group and state not in "ZX":
+            found.append(int(entry.name))
+    return found
+
+
+def test_closing_the_browser_ends_every_chromium_process_and_removes_its_profile(tmp_path):
+    _need("chromium", "chromium")
+    from gcodekit.report.pdf import Browser
+
+    (tmp_path / "p.html").write_text("<html><body><h1>page</h1></body></html>")
+    browser = Browser()
+    assert browser.print_pdf((tmp_path / "p.html").as_uri()).startswith(b"%PDF")
+    group = browser._proc.pid  # Chromium leads its own process group: its renderer and helpers are in it
+    assert len(_live_processes_of_group(group)) >= 2  # the browser and at least its renderer
+    profile = Path(browser._profile)
+    browser.close()
+    assert not profile.exists()
+    for _ in range(100):  # killed with the browser; the kernel ends them within moments
+        alive = _live_processes_of_group(group)
+        if not alive:
+            break
+        time.sleep(0.05)
+    assert not alive
+
+
+def test_chromium_prints_under_a_deep_temporary_folder(tmp_path, monkeypatch):
+    _need("chromium", "chromium")
+    from gcodekit.report.pdf import Browser
+
+    deep = tmp_path / ("d" * 60)  # Chromium's socket path would be longer than a socket address takes
+    deep.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(deep))
+    (tmp_path / "p.html").write_text("<html><body><h1>page</h1></body></html>")
+    browser = Browser()
+    try:
+        assert browser.print_pdf((tmp_path / "p.html").as_uri()).startswith(b"%PDF")
+    finally:
+        browser.close()
+    assert list(deep.iterdir()) == []
 
 
 def chromium_console(page: Path) -> tuple[list[str], str]:

@@ -19,6 +19,7 @@ import json
 import os
 import select
 import shutil
+import signal
 import subprocess
 import tempfile
 import threading
@@ -31,6 +32,8 @@ from ..errors import MissingDependencyError
 CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 #: Seconds Chromium may take to answer one request; a report page prints in about one.
 TIMEOUT_S = 120
+#: The longest path Chromium makes in its temporary folder: its single-instance socket.
+SOCKET_IN_TMPDIR = "org.chromium.Chromium.XXXXXX/SingletonSocket"
 
 
 class ChromiumNotFound(MissingDependencyError):
@@ -68,16 +71,18 @@ class Browser:
 
     def __init__(self) -> None:
         # a plain directory, not a TemporaryDirectory, whose finalizer would remove it in a forked child too
-        self._profile = tempfile.mkdtemp(prefix="gcodekit-chromium-")
+        self._profile = _new_profile()
         to_chromium, self._pipe = os.pipe()
         self._receive, from_chromium = os.pipe()
         # above 9, so that putting them on 3 and 4 below cannot overwrite one with the other
         to_chromium, from_chromium = (_above_9(fd) for fd in (to_chromium, from_chromium))
         cmd = chromium_command("--remote-debugging-pipe", "about:blank", profile=self._profile)
-        # bash (dash takes single-digit descriptors only) puts the pipe ends on 3 and 4, where Chromium reads
+        # bash (dash takes single-digit descriptors only) puts the pipe ends on 3 and 4, where Chromium reads;
+        # a session of its own, whose process group (Chromium and its helpers) close() ends at once
         self._proc = subprocess.Popen(["bash", "-c", f'exec "$0" "$@" 3<&{to_chromium} 4>&{from_chromium}', *cmd],
                                       pass_fds=(to_chromium, from_chromium), stdin=subprocess.DEVNULL,
-                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+                                      env={**os.environ, "TMPDIR": self._profile})
         os.close(to_chromium)
         os.close(from_chromium)
         self._buffer = b""
@@ -171,24 +176,36 @@ class Browser:
         return base64.b64decode(data)
 
     def close(self) -> None:
-        """Quit Chromium (killed if it does not within 10 s) and remove its profile."""
-        try:
-            self.call("Browser.close")
-        except (OSError, RuntimeError):
-            pass
+        """End Chromium and its helper processes, and remove its profile.
+
+        Killed, not asked to quit: the profile is thrown away, so there is
+        nothing to save, and ``Browser.close`` took 0.15-0.2 s of every
+        report command's end where the kill takes 0.04.
+        """
         for fd in (self._pipe, self._receive):
             os.close(fd)
-        try:
-            self._proc.wait(10)
-        except subprocess.TimeoutExpired:
-            self._proc.kill()
-            self._proc.wait()
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(self._proc.pid, signal.SIGKILL)
+        self._proc.wait()
         shutil.rmtree(self._profile, ignore_errors=True)
 
     def forget(self) -> None:
         """Close this process's ends of the pipe only: in a forked child, Chromium is the parent's."""
         for fd in (self._pipe, self._receive):
             os.close(fd)
+
+
+def _new_profile() -> str:
+    """A new folder for Chromium's profile and its temporary files (its ``TMPDIR``), removed with it.
+
+    Chromium listens on a socket in its temporary folder and stops at once
+    when that path is longer than a socket's address takes (107 bytes):
+    under a deep ``TMPDIR`` the profile goes into ``/tmp`` instead.
+    """
+    base = tempfile.gettempdir()
+    if len(os.path.join(base, "gcodekit-chromium-12345678", SOCKET_IN_TMPDIR)) > 107 and os.access("/tmp", os.W_OK):
+        base = "/tmp"
+    return tempfile.mkdtemp(prefix="gcodekit-chromium-", dir=base)
 
 
 def _above_9(fd: int) -> int:
