@@ -21,7 +21,11 @@ than gcodekit's array code).  gcodekit's time is
 emulating and planning, with whatever it imports on the way (Numba, when
 the compiled scanner is used); ``import gcodekit`` itself is left out, as
 the loop's interpreter start is.  Bytes per line are the whole peak over
-the file's lines.
+the file's lines.  The system time (``sys s``) is mostly the kernel giving
+the process fresh pages: on a virtual machine whose host takes back freed
+memory (as these do), every megabyte first touched costs about 2 ms, so a
+peak of 750 MB is also over a second of the run, and the same run's time
+moves with how much memory the host has reclaimed.
 
     python benchmarks/bench_scale.py                      # plate150 and the cylinder, 3 runs each
     python benchmarks/bench_scale.py --big                # and the 30 M-line file (one run each)
@@ -67,7 +71,9 @@ def child(tool: str, path: str) -> dict:
         op = gcodekit.gcode_to_operation(Path(path), machine)
         assert op.plan is not None
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
-    return {"seconds": seconds, "cpu_seconds": cpu, "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return {"seconds": seconds, "cpu_seconds": cpu, "peak_mb": usage.ru_maxrss / 1024,
+            "system_seconds": usage.ru_stime, "page_faults": usage.ru_minflt}
 
 
 def _run_child(tool: str, path: Path) -> dict:
@@ -96,20 +102,33 @@ def ten_plates(folder: Path) -> Path:
     return path
 
 
-def measure(path: Path, repeat: int, tools=TOOLS) -> list[dict]:
-    """Each tool ``repeat`` times, taking turns; the best time and the worst peak of each."""
+def measure(path: Path, repeat: int, tools=TOOLS, warm_up: bool = True) -> list[dict]:
+    """Each tool ``repeat`` times, taking turns; the best time and the worst peak of each.
+
+    With ``warm_up``, each gcodekit tool first runs once unmeasured: the first
+    run on a machine compiles Numba's kernels into its cache (seconds of CPU
+    and about 70 MB more peak, once per installation, as pip compiles the
+    bytecode), and reads the file into the page cache, as the loop's first run
+    does for it.
+    """
     lines = count_lines(path)
     runs: dict[str, list[dict]] = {t: [] for t in tools}
+    for tool in tools if warm_up else ():
+        if tool != "python_loop":
+            r = _run_child(tool, path)
+            print(f"  {tool:18s} {r['seconds']:7.2f} s {r['peak_mb']:8.1f} MB  (warm-up, not counted)", file=sys.stderr)
     for _ in range(repeat):
         for tool in tools:
             runs[tool].append(_run_child(tool, path))
             r = runs[tool][-1]
-            print(f"  {tool:18s} {r['seconds']:7.2f} s {r['peak_mb']:8.1f} MB", file=sys.stderr)
+            print(f"  {tool:18s} {r['seconds']:7.2f} s {r['peak_mb']:8.1f} MB  system {r['system_seconds']:5.2f} s, "
+                  f"{r['page_faults']:,} page faults", file=sys.stderr)
     records = []
     for tool in tools:
         peak = max(r["peak_mb"] for r in runs[tool])
         records.append({"tool": tool, "file": path.name, "seconds": min(r["seconds"] for r in runs[tool]),
                         "cpu_seconds": min(r.get("cpu_seconds", float("nan")) for r in runs[tool]),
+                        "system_seconds": min(r["system_seconds"] for r in runs[tool]),
                         "peak_mb": peak, "bytes_per_line": peak * 2**20 / lines, "lines": lines,
                         "runs": len(runs[tool])})
     return records
@@ -122,12 +141,12 @@ def report(records: list[dict]) -> bool:
         rows = [r for r in records if r["file"] == name]
         loop = next(r for r in rows if r["tool"] == "python_loop")
         print(f"\n{name}  {loop['lines']:,} lines")
-        print(f"  {'':18s} {'runs':>4s} {'best s':>8s} {'x loop':>7s} {'CPU s':>7s} {'x loop':>7s} {'peak MB':>9s} "
-              f"{'B/line':>7s}")
+        print(f"  {'':18s} {'runs':>4s} {'best s':>8s} {'x loop':>7s} {'CPU s':>7s} {'x loop':>7s} {'sys s':>6s} "
+              f"{'peak MB':>9s} {'B/line':>7s}")
         for r in rows:
             print(f"  {r['tool']:18s} {r['runs']:4d} {r['seconds']:8.2f} {r['seconds'] / loop['seconds']:7.2f} "
                   f"{r['cpu_seconds']:7.2f} {r['cpu_seconds'] / loop['cpu_seconds']:7.2f} "
-                  f"{r['peak_mb']:9.1f} {r['bytes_per_line']:7.1f}")
+                  f"{r.get('system_seconds', float('nan')):6.2f} {r['peak_mb']:9.1f} {r['bytes_per_line']:7.1f}")
         if name != PLATE.name:
             continue
         for r in rows:
@@ -165,7 +184,7 @@ def main(argv=None) -> int:
         with tempfile.TemporaryDirectory(prefix="gcodekit-bench-") as folder:
             path = ten_plates(Path(folder))
             print(f"{path.name}:", file=sys.stderr)
-            records += measure(path, 1)
+            records += measure(path, 1, warm_up=False)  # the kernels were compiled on plate150
     ok = report(records)
     if args.json:
         args.json.write_text(json.dumps(records, indent=1))

@@ -12,9 +12,10 @@ compare them.
 from __future__ import annotations
 
 import functools
-import sys
 
 import numpy as np
+
+from ..jit import compile_loops, numba_loaded
 
 __all__ = ["forward_fill", "forward_fill_numpy", "compiled", "COMPILED_FROM"]
 
@@ -25,16 +26,13 @@ COMPILED_FROM = 2048
 @functools.lru_cache(maxsize=1)
 def compiled():
     """The compiled loop, or None when Numba is not installed (compiled on first use, cached on disk)."""
-    try:
-        import numba
-    except ImportError:
-        return None
-    return numba.njit(cache=True, nogil=True)(_fill)
+    loops = compile_loops(_fill)
+    return loops and loops[0]
 
 
 def forward_fill(values: np.ndarray, initial: float) -> np.ndarray:
     """Each NaN of the float column ``values`` replaced by the last number before it (``initial`` at the start)."""
-    if values.size >= COMPILED_FROM and "numba" in sys.modules:
+    if values.size >= COMPILED_FROM and numba_loaded():
         kernel = compiled()
         if kernel is not None:
             return kernel(values, float(initial))

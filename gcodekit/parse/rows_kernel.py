@@ -20,9 +20,10 @@ does it.
 from __future__ import annotations
 
 import functools
-import sys
 
 import numpy as np
+
+from ..jit import compile_loops, numba_loaded
 
 __all__ = ["compiled", "use_compiled", "block_words_compiled", "simple_rows_compiled", "COMPILED_FROM_BLOCKS"]
 
@@ -36,11 +37,7 @@ _G, _M, _T = ord("G"), ord("M"), ord("T")
 def compiled():
     """The compiled loops (block words, rows), or None when Numba is not installed (compiled on first use,
     cached on disk)."""
-    try:
-        import numba
-    except ImportError:
-        return None
-    return numba.njit(cache=True, nogil=True)(_block_words), numba.njit(cache=True, nogil=True)(_rows)
+    return compile_loops(_block_words, _rows)
 
 
 def use_compiled(engine: str, n_blocks: int) -> bool:
@@ -54,7 +51,7 @@ def use_compiled(engine: str, n_blocks: int) -> bool:
         return False
     if engine == "numba":
         return True
-    return n_blocks >= COMPILED_FROM_BLOCKS and "numba" in sys.modules and compiled() is not None
+    return n_blocks >= COMPILED_FROM_BLOCKS and numba_loaded() and compiled() is not None
 
 
 def simple_rows_compiled(word_block: np.ndarray, word_letter: np.ndarray, word_value: np.ndarray,

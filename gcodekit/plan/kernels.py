@@ -26,6 +26,7 @@ from typing import Iterator
 import numpy as np
 
 from ..errors import MissingDependencyError, check_choice
+from ..jit import compile_loops
 
 __all__ = ["COMPILED_AFTER_MOVES", "ENGINES", "compiled", "engine", "using"]
 
@@ -38,17 +39,11 @@ _chosen = "auto"
 @functools.lru_cache(maxsize=1)
 def compiled() -> SimpleNamespace | None:
     """The compiled loops, or None when Numba is not installed (compiled on first use, cached on disk)."""
-    try:
-        import numba
-    except ImportError:
-        return None
+    loops = (_forward_min, _backward_min, _classic_jerk, _klipper_moves, _klipper_cruise, _move_points,
+             _marlin_trapezoids, _klipper_trapezoids, _marlin_blocks)
     # error_model="numpy": a division by zero gives inf or NaN, as in the NumPy code, instead of raising
-    jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-    return SimpleNamespace(forward_min=jit(_forward_min), backward_min=jit(_backward_min),
-                           classic_jerk=jit(_classic_jerk), klipper_moves=jit(_klipper_moves),
-                           klipper_cruise=jit(_klipper_cruise), move_points=jit(_move_points),
-                           marlin_trapezoids=jit(_marlin_trapezoids), klipper_trapezoids=jit(_klipper_trapezoids),
-                           marlin_blocks=jit(_marlin_blocks))
+    done = compile_loops(*loops, error_model="numpy")
+    return None if done is None else SimpleNamespace(**{f.__name__[1:]: c for f, c in zip(loops, done)})
 
 
 def engine(n_moves: int) -> SimpleNamespace | None:

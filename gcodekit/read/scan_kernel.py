@@ -22,6 +22,7 @@ import functools
 
 import numpy as np
 
+from ..jit import compile_loops
 from ..syntax import Flavor
 from .scan import (_BLANK, _COMMENT, _DIGIT, _DOT, _LOWER, _MAX_DIGITS, _NEWLINE, _POW10, _SIGN, _UPPER, ScanResult,
                    _byte_classes, _string_code_keys)
@@ -34,11 +35,8 @@ _POW10_INT = 10 ** np.arange(_MAX_DIGITS + 1, dtype=np.int64)
 @functools.lru_cache(maxsize=1)
 def compiled():
     """The compiled scanner loop, or None when Numba is not installed (compiled on first use, cached on disk)."""
-    try:
-        import numba
-    except ImportError:
-        return None
-    return numba.njit(cache=True, nogil=True)(_scan_lines)
+    loops = compile_loops(_scan_lines)
+    return loops and loops[0]
 
 
 @functools.lru_cache(maxsize=32)

@@ -15,9 +15,10 @@ the tests draw with both.
 from __future__ import annotations
 
 import functools
-import sys
 
 import numpy as np
+
+from ..jit import compile_loops, numba_loaded
 
 __all__ = ["COMPILED_FROM", "compiled", "engine"]
 
@@ -29,17 +30,14 @@ COMPILED_FROM = 200_000
 @functools.lru_cache(maxsize=1)
 def compiled():
     """The compiled loop, or None when Numba is not installed (compiled on first use, cached on disk)."""
-    try:
-        import numba
-    except ImportError:
-        return None
-    return numba.njit(cache=True, nogil=True)(draw_samples)
+    loops = compile_loops(draw_samples)
+    return loops and loops[0]
 
 
 def engine(n_segments: int):
     """The compiled loop for this many segments, or None for NumPy: compiled when Numba is loaded already
     (reading a large program loads it) or the picture is large enough to pay for loading it."""
-    if "numba" not in sys.modules and n_segments < COMPILED_FROM:
+    if not numba_loaded() and n_segments < COMPILED_FROM:
         return None
     return compiled()
 
