@@ -15,6 +15,8 @@ import pytest
 from hypothesis import settings
 
 sys.path.insert(0, str(Path(__file__).parent))  # test modules share helpers (test_linuxcnc_golden.tool_table)
+from shared_corpus import SHARED  # noqa: E402 -- from that folder
+
 settings.register_profile("deterministic", derandomize=True, database=None, print_blob=True)
 settings.register_profile("explore", derandomize=False, print_blob=True)
 settings.load_profile("deterministic")  # pytest's --hypothesis-profile=explore overrides it
@@ -23,7 +25,15 @@ settings.load_profile("deterministic")  # pytest's --hypothesis-profile=explore 
 @pytest.fixture(scope="session")
 def shared_dir() -> Path:
     """``/work/shared``-style folder with ``corpus/`` and ``seeds/``; skips if absent."""
-    path = Path(__file__).resolve().parents[2] / "shared"
+    path = SHARED
     if not path.is_dir():
-        pytest.skip(f"reference folder {path} not found")
+        pytest.skip(f"reference folder {path} not found (set GCODEKIT_SHARED)")
     return path
+
+
+def pytest_report_header() -> str:
+    """Said first: without the reference folder the tests on real programs and references skip."""
+    if SHARED.is_dir():
+        return f"reference folder: {SHARED}"
+    return (f"reference folder: {SHARED} NOT FOUND: the tests on the corpus and the references will skip "
+            "(set GCODEKIT_SHARED to the folder holding corpus/ and seeds/)")

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from cli_helpers import run
+from shared_corpus import CORPUS
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 MILL = EXAMPLES / "bracket_mill.ngc"
@@ -93,7 +94,7 @@ def test_a_stock_the_program_never_touches_is_a_warning(capsys):
 
 
 def _corpus_programs():
-    root = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "linuxcnc"
+    root = CORPUS / "linuxcnc"
     if not (root / "RESULTS.tsv").exists():
         return []
     overrides = {}

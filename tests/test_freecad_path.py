@@ -20,10 +20,11 @@ import pytest
 
 import gcodekit.path as gpath
 from gcodekit.path import FreeCADFormatError
+from shared_corpus import CORPUS as SHARED_CORPUS
 
 ROOT = FilePath(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "golden" / "freecad"
-CORPUS = ROOT.parent / "shared" / "corpus" / "linuxcnc"
+CORPUS = SHARED_CORPUS / "linuxcnc"
 
 sys.path.insert(0, str(GOLDEN))
 from freecad_cases import CASES, DIFFERENT, plain  # noqa: E402

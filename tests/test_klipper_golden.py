@@ -10,11 +10,12 @@ import pandas as pd
 import pytest
 
 import gcodekit
+from shared_corpus import CORPUS as SHARED_CORPUS
 
 HERE = Path(__file__).parent / "golden" / "klipper"
 CASES = HERE / "cases"
 CONFIG = HERE / "klipper_printer.cfg"
-SHARED_FFF = Path(__file__).parents[2] / "shared" / "corpus" / "fff"
+SHARED_FFF = SHARED_CORPUS / "fff"
 TOTALS = {r["case"]: float(r["klipper_total_s"]) for r in csv.DictReader(open(CASES / "totals.csv"))}
 CORPUS = {r["file"]: float(r["klipper_total_s"]) for r in csv.DictReader(open(HERE / "corpus_totals.csv"))}
 

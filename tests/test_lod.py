@@ -10,8 +10,9 @@ import gcodekit
 from gcodekit import visualize
 from gcodekit.view import Camera
 from gcodekit.view.lod import last_drawn, painter_order, polylines
+from shared_corpus import CORPUS as SHARED_CORPUS
 
-CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus" / "fff"
+CORPUS = SHARED_CORPUS / "fff"
 
 
 # -- painter's order ------------------------------------------------------------------------------------------------

@@ -17,13 +17,14 @@ from hypothesis import strategies as st
 import gcodekit
 from gcodekit.plan import kernels, marlin, planner_settings, run_planner, scans
 from gcodekit.plan import moves as moves_module
+from shared_corpus import CORPUS as SHARED_CORPUS
 
 if kernels.compiled() is None:
     pytest.skip("Numba is not installed (pip install 'gcodekit[fast]')", allow_module_level=True)
 
 HERE = Path(__file__).parent / "golden" / "klipper"
 CASES = HERE / "cases"
-SHARED_FFF = Path(__file__).parents[2] / "shared" / "corpus" / "fff"
+SHARED_FFF = SHARED_CORPUS / "fff"
 
 
 def assert_bits_equal(a, b, what: str) -> None:

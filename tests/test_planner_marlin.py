@@ -22,9 +22,10 @@ from gcodekit.plan import lookahead, marlin
 from gcodekit.plan.moves import firmware_moves
 from gcodekit.plan.moves import speed_factor as _speed_factor
 from gcodekit.parse.table import NAME_ID
+from shared_corpus import CORPUS as SHARED_CORPUS
 
 CASES = Path(__file__).parent / "golden" / "klipper" / "cases"  # cube20_marlin2.gcode lives there
-SHARED_FFF = Path(__file__).parents[2] / "shared" / "corpus" / "fff"
+SHARED_FFF = SHARED_CORPUS / "fff"
 CLASSIC = marlin.MarlinConfig(classic_jerk=True)
 
 

@@ -18,6 +18,7 @@ import pytest
 
 import gcodekit
 from gcodekit.syntax import detect_flavor
+from shared_corpus import CORPUS
 
 # file -> (flavor, machine, process): what its header or content says it was written for (README.md's kind)
 EXPECTED = {
@@ -108,7 +109,7 @@ ESTIMATES = {
 
 @pytest.fixture(scope="module")
 def realworld(request) -> Path:
-    path = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "realworld"
+    path = CORPUS / "realworld"
     if not path.is_dir():
         pytest.skip(f"reference folder {path} not found")
     return path

@@ -31,9 +31,10 @@ from gcodekit import cli
 from gcodekit.emulate.presets import load_machine, machine_named_in
 from gcodekit.model.slicer import compare, parse_duration
 from gcodekit.plan.marlin import limits_from_slicer
+from shared_corpus import CORPUS
 
 GOLDEN = Path(__file__).parent / "golden" / "slicers"
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "corpus"
+SHARED = CORPUS
 CURA_DEFINITIONS = Path("/usr/share/cura/resources/definitions")
 
 PRUSA_FILES = ["prusa_mk3s_cube20.gcode.gz", "prusa_mk3s_cylinder_estimate_only.gcode.gz"]

@@ -21,9 +21,10 @@ from gcodekit.view import Toolpath, coloring, overview  # noqa: E402
 from gcodekit.view.overview import CORNER_DEG, chords, runs  # noqa: E402
 from gcodekit.widgets import LayerViewer, VelocityPlot  # noqa: E402
 from gcodekit.widgets.layer_viewer import SEGMENT_BYTES  # noqa: E402
+from shared_corpus import CORPUS as SHARED_CORPUS
 
 ROOT = Path(__file__).resolve().parents[1]
-CORPUS = ROOT.parent / "shared" / "corpus" / "fff"
+CORPUS = SHARED_CORPUS / "fff"
 CUBE = CORPUS / "cube20_marlin2.gcode"
 
 

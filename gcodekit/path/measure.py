@@ -187,12 +187,27 @@ def bound_box(commands: Commands) -> BoundBox:
 
 # -- FreeCAD 0.20's answers -------------------------------------------------------------
 
+def _dot(u: Sequence[float], v: Sequence[float]) -> float:
+    """``u * v`` as FreeCAD's ``Vector3d`` computes it: three products summed left to right in plain doubles.
+
+    Not NumPy's dot, whose BLAS kernel (fused multiply-adds on some CPUs)
+    rounds the last bit differently from machine to machine: near a straight
+    angle ``acos`` magnifies that bit to a millionth of a millimetre.
+    """
+    return float(u[0]) * float(v[0]) + float(u[1]) * float(v[1]) + float(u[2]) * float(v[2])
+
+
+def _length(u: Sequence[float]) -> float:
+    """``Vector3d::Length``: the square root of the sum of the squares, in that order."""
+    return math.sqrt(_dot(u, u))
+
+
 def _freecad_angle(u: np.ndarray, v: np.ndarray) -> float:
     """FreeCAD's ``Vector3d::GetAngle``: the smaller angle, NaN for a zero vector."""
-    norm = math.sqrt(float(u @ u)) * math.sqrt(float(v @ v))
+    norm = _length(u) * _length(v)
     if norm <= np.finfo(float).eps:
         return math.nan
-    return math.acos(max(-1.0, min(1.0, float(u @ v) / norm)))
+    return math.acos(max(-1.0, min(1.0, _dot(u, v) / norm)))
 
 
 def freecad_length(commands: Sequence[tuple[str, dict[str, float]]]) -> float:
@@ -204,10 +219,10 @@ def freecad_length(commands: Sequence[tuple[str, dict[str, float]]]) -> float:
             continue
         nxt = np.array([p.get(a, last[k]) for k, a in enumerate("XYZ")])
         if name in _RAPID + _FEED:
-            total += float(np.linalg.norm(nxt - last))
+            total += _length(nxt - last)
         else:
             center = np.array([p.get("I", 0.0), p.get("J", 0.0), p.get("K", 0.0)])
-            total += _freecad_angle(nxt - center, last - center) * float(np.linalg.norm(last - center))
+            total += _freecad_angle(nxt - center, last - center) * _length(last - center)
         last = nxt
     return total
 

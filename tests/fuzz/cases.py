@@ -27,9 +27,11 @@ import random
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from shared_corpus import CORPUS as SHARED_CORPUS
+
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
-CORPUS = ROOT.parent / "shared" / "corpus" / "linuxcnc" / "nc_files"
+CORPUS = SHARED_CORPUS / "linuxcnc" / "nc_files"
 
 #: Every command runs under this motion limit: it keeps the worst case within the
 #: suite's 2 GB memory cap (the default, 50 million, is sized for real programs).
