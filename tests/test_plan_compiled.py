@@ -145,6 +145,25 @@ def test_auto_engine_by_size():
             pass
 
 
+def test_an_engine_chosen_in_one_thread_is_that_thread_s_alone():
+    import threading
+
+    chosen, seen = threading.Event(), {}
+
+    def other() -> None:
+        chosen.wait()
+        seen["other"] = kernels.engine(10**9)  # another thread, planning meanwhile: still the default
+
+    worker = threading.Thread(target=other)
+    worker.start()
+    with kernels.using("numpy"):
+        chosen.set()
+        worker.join()
+        seen["here"] = kernels.engine(10**9)
+    assert seen["here"] is None and seen["other"] is kernels.compiled() is not None
+    assert kernels.engine(10**9) is kernels.compiled()  # restored at the block's end
+
+
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.tuples(*[st.sampled_from([0.0, 1.0, 2.0, 4.0, 9.0, 1e-12, np.inf])] * 5, st.booleans()),

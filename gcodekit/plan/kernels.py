@@ -19,6 +19,7 @@ would spend more loading Numba than they save), NumPy otherwise;
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import functools
 from types import SimpleNamespace
 from typing import Iterator
@@ -33,7 +34,8 @@ __all__ = ["COMPILED_AFTER_MOVES", "ENGINES", "compiled", "engine", "using"]
 #: Programs with at least this many moves are planned by the compiled loops when Numba is installed.
 COMPILED_AFTER_MOVES = 300_000
 ENGINES = ("auto", "numba", "numpy")
-_chosen = "auto"
+#: The engine :func:`using` chose: per thread and per asyncio task, so one caller's choice never reaches another
+_chosen: contextvars.ContextVar[str] = contextvars.ContextVar("gcodekit_plan_engine", default="auto")
 
 
 @functools.lru_cache(maxsize=1)
@@ -48,10 +50,11 @@ def compiled() -> SimpleNamespace | None:
 
 def engine(n_moves: int) -> SimpleNamespace | None:
     """The compiled loops to plan ``n_moves`` moves with, or None for the NumPy code."""
-    if _chosen == "numpy" or (_chosen == "auto" and n_moves < COMPILED_AFTER_MOVES):
+    chosen = _chosen.get()
+    if chosen == "numpy" or (chosen == "auto" and n_moves < COMPILED_AFTER_MOVES):
         return None
     kernels = compiled()
-    if kernels is None and _chosen == "numba":
+    if kernels is None and chosen == "numba":
         raise MissingDependencyError("the compiled planner needs Numba: pip install 'gcodekit[fast]'")
     return kernels
 
@@ -60,19 +63,21 @@ def engine(n_moves: int) -> SimpleNamespace | None:
 def using(name: str) -> Iterator[None]:
     """Plan with engine ``name`` inside the block: ``"numba"``, ``"numpy"`` or ``"auto"`` (the default).
 
+    The choice holds in this thread (or asyncio task) only: other threads
+    planning meanwhile keep their own.
+
     Examples
     --------
     >>> import gcodekit
     >>> with using("numpy"):
     ...     op = gcodekit.gcode_to_operation("G1 X10 E1 F600\\n", "marlin")
     """
-    global _chosen
     check_choice("engine", name, ENGINES)
-    previous, _chosen = _chosen, name
+    token = _chosen.set(name)
     try:
         yield
     finally:
-        _chosen = previous
+        _chosen.reset(token)
 
 
 def _forward_min(cap, inc, first, block):
