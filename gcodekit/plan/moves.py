@@ -232,13 +232,32 @@ def settings_in_force(op: "EmulatedProgram", moves: PlannerMoves, rows: np.ndarr
 
 
 def happens_before(moves: PlannerMoves, rows: np.ndarray) -> np.ndarray:
-    """Per move: does one of ``rows`` come between the previous move and this one?"""
-    if rows.size == 0 or len(moves) == 0:
-        return np.zeros(len(moves), bool)
-    previous = np.r_[-1, moves.row[:-1]]
-    same_row = previous == moves.row  # chords of one arc have nothing between them
-    count_before = searchsorted_many(rows, moves.row, side="left") - searchsorted_many(rows, previous, side="right")
-    return (count_before > 0) & ~same_row
+    """Per move: does one of ``rows`` (sorted) come between the previous move and this one?
+
+    Moves come in program order, so each command row is placed among the
+    moves' rows: the first move past it has it in between when that move's
+    predecessor comes before it.  Arrays the size of ``rows`` (a program's
+    few thousand setting commands) instead of four the size of the moves,
+    which on a 3 M-line program left 47 MB of freed heap under the planner's
+    peak.  Moves out of order (none that :func:`firmware_moves` makes) are
+    counted move by move.
+    """
+    n = len(moves)
+    out = np.zeros(n, bool)
+    if rows.size == 0 or n == 0:
+        return out
+    row = moves.row
+    if not bool(np.all(row[1:] >= row[:-1])):
+        previous = np.r_[-1, row[:-1]]
+        same_row = previous == row  # chords of one arc have nothing between them
+        count_before = searchsorted_many(rows, row, side="left") - searchsorted_many(rows, previous, side="right")
+        return (count_before > 0) & ~same_row
+    first_after = np.searchsorted(row, rows, side="right")  # the first move whose row is past each command's
+    inside = first_after < n
+    first_after, command = first_after[inside], rows[inside]
+    before = np.where(first_after > 0, row[np.maximum(first_after - 1, 0)], -1)  # that move's predecessor
+    out[first_after[before < command]] = True  # not the command of the predecessor itself
+    return out
 
 
 def follows_kept_step(moves: PlannerMoves, kept: np.ndarray) -> np.ndarray:

@@ -1,0 +1,40 @@
+"""The moves a planner takes: which setting commands come between two moves (``plan.moves.happens_before``)."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gcodekit.plan.moves import PlannerMoves, happens_before
+
+
+def _moves(rows: list[int]) -> PlannerMoves:
+    n = len(rows)
+    return PlannerMoves(start=np.zeros((n, 4)), end=np.zeros((n, 4)), speed_v=np.ones(n),
+                        row=np.asarray(rows, np.int32), waypoint=np.arange(n, dtype=np.int32))
+
+
+def _by_hand(move_rows: list[int], command_rows: list[int]) -> list[bool]:
+    """Move i: is there a command row strictly between the previous move's row (-1 for the first) and its own?"""
+    return [any(previous < r < row for r in command_rows)
+            for previous, row in zip([-1, *move_rows[:-1]], move_rows)]
+
+
+def test_a_dwell_between_moves_marks_the_move_after_it():
+    # rows: 0 G1, 1 G1, 2 G4 (the command), 3 G1, 4 G1 (a segmented arc: two moves), 5 M400, 6 G1
+    moves = _moves([0, 1, 3, 4, 4, 6])
+    assert happens_before(moves, np.array([2, 5])).tolist() == [False, False, True, False, False, True]
+    assert happens_before(moves, np.array([4])).tolist() == [False] * 6  # a move's own row is not between
+    assert happens_before(moves, np.array([9])).tolist() == [False] * 6  # after the last move: none follows
+    assert happens_before(moves, np.array([], np.int64)).tolist() == [False] * 6
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.integers(0, 60), max_size=40), st.sets(st.integers(0, 70), max_size=12), st.booleans())
+def test_commands_between_moves_as_counted_by_hand(move_rows, command_rows, in_order):
+    if in_order:
+        move_rows = sorted(move_rows)  # as firmware_moves makes them; otherwise the move-by-move count
+    commands = sorted(command_rows)
+    got = happens_before(_moves(move_rows), np.asarray(commands, np.int64))
+    assert got.tolist() == _by_hand(move_rows, commands)
