@@ -31,9 +31,17 @@ def shared_dir() -> Path:
     return path
 
 
-def pytest_report_header() -> str:
-    """Said first: without the reference folder the tests on real programs and references skip."""
-    if SHARED.is_dir():
-        return f"reference folder: {SHARED}"
-    return (f"reference folder: {SHARED} NOT FOUND: the tests on the corpus and the references will skip "
+def _missing_reference_folder() -> str:
+    return (f"reference folder {SHARED} NOT FOUND: the tests on the corpus and the references skipped "
             "(set GCODEKIT_SHARED to the folder holding corpus/ and seeds/)")
+
+
+def pytest_report_header() -> str:
+    """Said first (in verbose runs): without the reference folder the tests on real programs and references skip."""
+    return f"reference folder: {SHARED}" if SHARED.is_dir() else _missing_reference_folder()
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """Said last, in quiet runs too, when the reference folder is missing."""
+    if not SHARED.is_dir():
+        terminalreporter.write_line(_missing_reference_folder(), yellow=True, bold=True)

@@ -1,9 +1,8 @@
 """Where the reference folder is: ``shared/`` beside the checkout (``corpus/``, ``seeds/``), or ``$GCODEKIT_SHARED``.
 
 One definition for every test module: a checkout elsewhere (a git worktree,
-say) names the folder with ``GCODEKIT_SHARED``, and the session's header
-says whether it was found, since without it the tests on real programs and
-references skip.
+say) names the folder with ``GCODEKIT_SHARED``; without it the tests on
+real programs and references skip, and the run's summary says so.
 """
 
 from __future__ import annotations
