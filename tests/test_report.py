@@ -273,19 +273,29 @@ def test_pages_printed_one_after_another_each_show_their_own_text(tmp_path):
         assert text.strip() == f"page {k}"
 
 
-def _live_processes_of_group(group: int) -> list[int]:
-    """The processes of process group ``group`` still running (zombies, dead and not yet reaped, left out)."""
-    found = []
+def _process_table() -> dict[int, tuple[int, str]]:
+    """Every process: its parent and its state (``Z``: dead, not yet reaped)."""
+    table = {}
     for entry in Path("/proc").iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()  # after the command's name
-        except OSError:  # ended meanwhile
-            continue
-        state, pgrp = fields[0], int(fields[2])
-        if pgrp == group and state not in "ZX":
-            found.append(int(entry.name))
+        if entry.name.isdigit():
+            try:
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()  # after the command's name
+            except OSError:  # ended meanwhile
+                continue
+            table[int(entry.name)] = int(fields[1]), fields[0]
+    return table
+
+
+def _running(pids: list[int]) -> list[int]:
+    table = _process_table()
+    return [p for p in pids if p in table and table[p][1] not in "ZX"]
+
+
+def _descendants(pid: int) -> list[int]:
+    table, found, frontier = _process_table(), [], {pid}
+    while frontier:
+        frontier = {p for p, (parent, _) in table.items() if parent in frontier}
+        found += frontier
     return found
 
 
@@ -296,17 +306,16 @@ def test_closing_the_browser_ends_every_chromium_process_and_removes_its_profile
     (tmp_path / "p.html").write_text("<html><body><h1>page</h1></body></html>")
     browser = Browser()
     assert browser.print_pdf((tmp_path / "p.html").as_uri()).startswith(b"%PDF")
-    group = browser._proc.pid  # Chromium leads its own process group: its renderer and helpers are in it
-    assert len(_live_processes_of_group(group)) >= 2  # the browser and at least its renderer
+    helpers = _running(_descendants(browser._proc.pid))
+    assert helpers  # its zygote and renderer
     profile = Path(browser._profile)
     browser.close()
-    assert not profile.exists()
-    for _ in range(100):  # killed with the browser; the kernel ends them within moments
-        alive = _live_processes_of_group(group)
-        if not alive:
+    assert browser._proc.returncode is not None and not profile.exists()
+    for _ in range(100):  # the helpers end by themselves once the browser is gone
+        if not _running(helpers):
             break
         time.sleep(0.05)
-    assert not alive
+    assert _running(helpers) == []
 
 
 def test_chromium_prints_under_a_deep_temporary_folder(tmp_path, monkeypatch):
