@@ -21,6 +21,7 @@ import atexit
 import json
 import math
 import os
+import signal
 import sys
 from pathlib import Path
 from typing import Any, NoReturn, Sequence
@@ -203,9 +204,15 @@ def run() -> NoReturn:
     the standard streams are flushed; then the process ends without tearing
     down every imported module (NumPy, Numba, matplotlib, VTK) one by one,
     which took a report command a quarter of a second after its work was done.
-    Every file the command writes is closed by then.
+    Every file the command writes is closed by then.  A SIGTERM (``timeout``,
+    a batch system, ``kill``) ends the command the same way, with status 143,
+    instead of leaving its Chromium running.
     """
-    status = main()
+    signal.signal(signal.SIGTERM, _terminated)
+    try:
+        status = main()
+    except SystemExit as stop:  # argparse's --help, --version and usage errors, and a SIGTERM
+        status = _exit_status(stop.code)
     atexit._run_exitfuncs()  # noqa: SLF001 -- what interpreter shutdown runs first, run before the quick exit
     for stream in (sys.stdout, sys.stderr):
         try:
@@ -213,6 +220,20 @@ def run() -> NoReturn:
         except (BrokenPipeError, ValueError):  # the reader has gone (``| head``), or the stream was closed
             pass
     os._exit(status)
+
+
+def _terminated(signum: int, frame: object) -> None:
+    raise SystemExit(128 + signum)
+
+
+def _exit_status(code: object) -> int:
+    """The status ``sys.exit(code)`` gives: 0 for None, the number, else 1 with the code said on stderr."""
+    if code is None:
+        return 0
+    if isinstance(code, int):
+        return code
+    print(code, file=sys.stderr)
+    return 1
 
 
 def _internal_error(exc: Exception, debug: bool) -> int:

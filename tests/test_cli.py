@@ -159,3 +159,32 @@ def test_the_report_command_ends_its_chromium_and_leaves_no_profile(tmp_path):
         assert list(temp.iterdir()) == []  # the exit handlers ran: the profile and Chromium's own files are gone
     finally:
         shutil.rmtree(temp)
+
+
+def test_a_terminated_report_ends_its_chromium_and_leaves_no_profile(tmp_path):
+    import signal
+    import time
+
+    import pytest
+
+    if not shutil.which("chromium"):
+        pytest.skip("chromium not found: apt-get install chromium (scripts/setup.sh does as root)")
+    big = tmp_path / "big.gcode"  # long enough to read that the signal comes while the report is made
+    big.write_text("G21\nG90\nM83\n" + "G1 X10 Y0 E0.1 F1800\nG1 X10 Y10 E0.1\nG1 X0 Y10 E0.1\nG1 X0 Y0 E0.1\n"
+                   * 250_000)
+    temp = Path(tempfile.mkdtemp(prefix="t", dir="/tmp"))  # short: the browser's profile is made in it
+    try:
+        with subprocess.Popen([sys.executable, "-m", "gcodekit.cli", "report", str(big), "-o", str(tmp_path / "out"),
+                               "--no-progress"], env={**os.environ, "TMPDIR": str(temp)},
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE) as proc:
+            for _ in range(600):  # Chromium is started as the command begins
+                if list(temp.glob("gcodekit-chromium-*")) or proc.poll() is not None:
+                    break
+                time.sleep(0.05)
+            assert proc.poll() is None, "the report ended before it could be stopped"
+            proc.send_signal(signal.SIGTERM)
+            proc.communicate(timeout=60)
+        assert proc.returncode == 128 + signal.SIGTERM
+        assert list(temp.iterdir()) == []  # the exit handlers ran: Chromium's profile is gone
+    finally:
+        shutil.rmtree(temp)
