@@ -13,7 +13,6 @@ import pytest
 import gcodekit
 from gcodekit.parse import GcodeParser
 from gcodekit.parse.table import NAME_ID, SparseColumn, in_ids
-from gcodekit.plan.lookahead import trapezoid
 from gcodekit.plan.moves import PlannerMoves, in_force
 from gcodekit.read import read_text
 
@@ -50,20 +49,6 @@ def test_in_force_shortcuts_agree_with_the_search(set_rows):
     k = np.searchsorted(rows, moves.row, side="left") - 1  # the general rule, written out
     expected = np.where(k >= 0, values[np.maximum(k, 0)], -1.0) if rows.size else np.full(len(moves), -1.0)
     assert np.array_equal(in_force(moves, rows, values, -1.0), expected)
-
-
-def test_trapezoid_written_over_its_inputs_is_the_same():
-    rng = np.random.default_rng(7)
-    n = 40_000  # more than one block of the element-wise steps
-    move_d, accel = rng.uniform(0.01, 20, n), rng.uniform(100, 3000, n)
-    nominal_v2 = rng.uniform(1, 150, n) ** 2
-    entry_v2, exit_v2 = nominal_v2 * rng.uniform(0, 1, n), nominal_v2 * rng.uniform(0, 1, n)
-    plain = trapezoid(move_d, accel, entry_v2.copy(), nominal_v2.copy(), exit_v2.copy())
-    inputs = (entry_v2.copy(), nominal_v2.copy(), exit_v2.copy())
-    reused = trapezoid(move_d, accel, *inputs, reuse=True)
-    assert reused.start_v is inputs[0] and reused.cruise_v is inputs[1] and reused.end_v is inputs[2]
-    for field in ("start_v", "cruise_v", "end_v", "accel_t", "cruise_t", "decel_t"):
-        assert np.array_equal(getattr(plain, field), getattr(reused, field)), field
 
 
 def test_names_from_the_parsers_table_match_the_flavor():

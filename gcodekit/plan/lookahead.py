@@ -12,6 +12,7 @@ import numpy as np
 
 from .moves import PlanResult
 from .scans import backward_min, forward_min
+from .trapezoids import TrapezoidPlan
 
 __all__ = ["BLOCK", "limit_by_axis_maximum", "lookahead", "trapezoid", "empty_result", "unit_vectors"]
 
@@ -100,29 +101,18 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
 
 
 def trapezoid(move_d: np.ndarray, accel: np.ndarray, entry_v2: np.ndarray, nominal_v2: np.ndarray,
-              exit_v2: np.ndarray, *, reuse: bool = False) -> PlanResult:
+              exit_v2: np.ndarray) -> PlanResult:
     """Phase speeds and durations of trapezoidal moves.
 
     Accelerate from the entry speed, cruise at the nominal speed, brake to
     the exit speed; a move too short to cruise peaks where accelerating and
     braking meet (Marlin's ``intersection_distance``, grbl's ``st_prep_buffer``
     ramp).  An entry above what the move can brake from is clipped, as the
-    firmware's step generator does.  With ``reuse`` the speeds are written
-    over ``entry_v2``, ``nominal_v2`` and ``exit_v2`` (float64 arrays the
-    caller no longer needs), a block at a time after it is read: three
-    arrays fewer at the peak.
+    firmware's step generator does.  Every field at once, a block of moves
+    at a time (:class:`.trapezoids.TrapezoidPlan`, which Marlin's planner
+    keeps instead, to compute them when read).
     """
-    n = move_d.size
-    if reuse and all(isinstance(a, np.ndarray) and a.dtype == np.float64 and a.size == n and a.flags.writeable
-                     and a.strides == (8,) for a in (entry_v2, nominal_v2, exit_v2)):
-        start_v, cruise_v, end_v = entry_v2, nominal_v2, exit_v2
-    else:
-        start_v, cruise_v, end_v = np.empty(n), np.empty(n), np.empty(n)
-    result = PlanResult(start_v, cruise_v, end_v, np.asarray(accel, float), np.empty(n), np.empty(n), np.empty(n))
-    for lo in range(0, n, BLOCK):
-        sl = slice(lo, min(lo + BLOCK, n))
-        _trapezoid_block(move_d[sl], accel[sl], entry_v2[sl], nominal_v2[sl], exit_v2[sl], result, sl)
-    return result
+    return TrapezoidPlan(_trapezoid_block, move_d, np.asarray(accel, float), entry_v2, nominal_v2, exit_v2).phases()
 
 
 def _trapezoid_block(move_d, accel, entry_v2, nominal_v2, exit_v2, result: PlanResult, sl: slice) -> None:

@@ -37,6 +37,18 @@ class _Discard:
         pass
 
 
+def _computed(field: str) -> property:
+    """The property reading ``field`` of every move, computed on each read (:meth:`TrapezoidPlan.phases`
+    computes several at once)."""
+
+    def read(self: "TrapezoidPlan") -> np.ndarray:
+        return getattr(self._compute((field,)), field)
+
+    read.__name__ = field
+    read.__doc__ = f"Each move's ``{field}`` (see :class:`.moves.PlanResult`), computed when read."
+    return property(read)
+
+
 class TrapezoidPlan:
     """:class:`.moves.PlanResult`'s arrays, computed from the squared speeds when read.
 
@@ -91,29 +103,12 @@ class TrapezoidPlan:
             self._shape(move_d[s], accel[s], *(a[s] for a in v2), out, s)
         return out
 
-    @property
-    def start_v(self) -> np.ndarray:
-        return self._compute(("start_v",)).start_v
-
-    @property
-    def cruise_v(self) -> np.ndarray:
-        return self._compute(("cruise_v",)).cruise_v
-
-    @property
-    def end_v(self) -> np.ndarray:
-        return self._compute(("end_v",)).end_v
-
-    @property
-    def accel_t(self) -> np.ndarray:
-        return self._compute(("accel_t",)).accel_t
-
-    @property
-    def cruise_t(self) -> np.ndarray:
-        return self._compute(("cruise_t",)).cruise_t
-
-    @property
-    def decel_t(self) -> np.ndarray:
-        return self._compute(("decel_t",)).decel_t
+    start_v = _computed("start_v")
+    cruise_v = _computed("cruise_v")
+    end_v = _computed("end_v")
+    accel_t = _computed("accel_t")
+    cruise_t = _computed("cruise_t")
+    decel_t = _computed("decel_t")
 
     @property
     def duration_t(self) -> np.ndarray:
