@@ -15,10 +15,20 @@ import pytest
 from cli_helpers import run
 
 import gcodekit
+import gcodekit.pipeline.source
 from gcodekit.errors import GcodeError, ProgramFileError
 from gcodekit.read import MAX_LINE_LENGTH
 
 PROGRAM = "".join(f"G1 X{k}.5 Y{2 * k} F600\n" for k in range(1, 2001))  # 2000 feed moves, distinct X
+
+
+@pytest.fixture(autouse=True, params=["serial", "read ahead"])
+def reader(request, monkeypatch):
+    """Each test twice: read on the calling thread, and read ahead on a second thread (large files' way)."""
+    if request.param == "read ahead":
+        monkeypatch.setattr(gcodekit.pipeline.source, "READ_AHEAD_BYTES", 0)
+    else:
+        monkeypatch.setattr(gcodekit.pipeline.source, "READ_AHEAD_BYTES", 1 << 62)
 
 
 def xs(op) -> list[float]:

@@ -20,6 +20,7 @@ from ..errors import Diagnostics
 from ..limits import Limits
 from ..parse import CommandTable
 from ..read import Blocks, iter_counted_blocks, iter_lines
+from ..read.ahead import read_ahead
 from ..read.percent import until_closing_percent
 from ..syntax import Flavor
 from .feedback import MachineFeedback, MachineStop
@@ -31,6 +32,8 @@ _O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
 _SUBPROGRAM_M = re.compile(r"(?i)m\s*0*9\s*[89](?![\s.]*\d)")  # M98/M99: Fanuc-style subprogram flow
 #: Line numbers from here up stand for lines of subroutine files (see number_other_files)
 ELSEWHERE_LINES = 1 << 30
+#: Program files from this size on disk are read on a second thread, ahead of the machine (see read.ahead)
+READ_AHEAD_BYTES = 1 << 20
 
 
 def program_blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None,
@@ -86,14 +89,25 @@ def program_blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, b
                 out = feedback.watch(out, store)
             yield from MachineStop.read(out, flavor, diagnostics, len(lines))
             return
-        chunks: Iterator[bytes] = iter_lines(text)
+        chunks: Callable[[Diagnostics], Iterator[bytes]] = lambda _: iter_lines(text)
     else:
-        chunks = program.chunks(diagnostics)
+        chunks = program.chunks
+    size = program.path.stat().st_size if program.path is not None and not program.preprocessed else 0
+
+    def blocks(reported_to: Diagnostics) -> Iterator[tuple[Blocks, int]]:
+        return _plain_blocks(chunks(reported_to), flavor, reported_to, bar, size)
+
+    # a large file's next chunk is read on another thread while the machine runs this one
+    yield from read_ahead(blocks, diagnostics) if size >= READ_AHEAD_BYTES else blocks(diagnostics)
+
+
+def _plain_blocks(chunks: Iterator[bytes], flavor: Flavor, diagnostics: Diagnostics, bar=None,
+                  size: int = 0) -> Iterator[tuple[Blocks, int]]:
+    """The blocks of a program that needs no preprocessing (``size``: its file's, when known)."""
     if flavor.percent_delimiter:
         chunks = until_closing_percent(chunks)
     if bar is not None:
         chunks = _shown(chunks, bar)
-    size = program.path.stat().st_size if program.path is not None and not program.preprocessed else 0
     yield from iter_counted_blocks(chunks, flavor, diagnostics, size_hint=size)  # each holds every chunk taken so far
 
 
