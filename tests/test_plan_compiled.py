@@ -198,6 +198,40 @@ def test_move_points_agree():
         assert np.shares_memory(ref.start, ref.end) == np.shares_memory(got.start, got.end)
 
 
+@pytest.mark.parametrize("text", [
+    # chained moves, the first from waypoint 0 (starts at the origin)
+    "G1 X1 Y2 E0.5 F600\nG1 X3 E1\nG1 E1.5\nG1 X-0 Y-0\nG1 Z0.3\n",
+    # homing first, a zero-length move, a position jump (G92): not chained
+    "G28\nG1 X0 Y0 F600\nG1 X10 E1\nG1 X10\nG1 E2\nG92 X0\nG1 X5 E3\nG28 X\nG1 X3 Y3\nG1 Z0.3\n",
+])
+@pytest.mark.parametrize("name", ["numpy", "numba"])
+def test_gathered_move_points_are_the_stored_ones(text, name):
+    """Marlin reads the moves' points a block at a time from the waypoints; every slice is the stored one."""
+    op = gcodekit.gcode_to_operation(text, "marlin", plan=False)
+    with kernels.using(name):
+        stored = moves_module.firmware_moves(op)
+        gathered = moves_module.firmware_moves(op, gathered=True)
+    assert not isinstance(gathered.start, np.ndarray) and gathered.start.shape == stored.start.shape
+    n = len(stored)
+    for lo in range(n + 1):
+        for hi in range(lo, n + 2):
+            assert_bits_equal(stored.start[lo:hi], gathered.start[lo:hi], f"start[{lo}:{hi}]")
+            assert_bits_equal(stored.end[lo:hi], gathered.end[lo:hi], f"end[{lo}:{hi}]")
+    assert_bits_equal(stored.axes_d, gathered.axes_d, "axes_d")
+    for field in ("speed_v", "row", "waypoint"):
+        assert_bits_equal(getattr(stored, field), getattr(gathered, field), field)
+
+
+def test_gathered_points_of_a_program_with_arcs_are_stored_chords():
+    op = gcodekit.gcode_to_operation("G1 X1 Y0 F600\nG2 X-1 Y0 I-1 J0 E1\nG1 X0\n", "marlin", plan=False)
+    cut = lambda travel, *_: np.maximum(np.floor(travel / 0.5), 1.0)  # noqa: E731
+    stored = moves_module.firmware_moves(op, None, cut)
+    gathered = moves_module.firmware_moves(op, None, cut, gathered=True)
+    assert len(stored) > 3 and isinstance(gathered.start, np.ndarray)
+    assert_bits_equal(stored.start, gathered.start, "start")
+    assert np.shares_memory(gathered.start, gathered.end) == np.shares_memory(stored.start, stored.end)
+
+
 trapezoid_v2 = st.one_of(st.floats(0.0, 1e5), st.sampled_from([0.0, 1.0, 4.0, 25.0, 1e-300, np.inf]))
 
 

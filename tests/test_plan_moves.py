@@ -6,7 +6,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gcodekit.plan.moves import PlannerMoves, happens_before
+from gcodekit import plan
+from gcodekit.plan.moves import PlannedMoves, PlannerMoves, PlanResult, happens_before
 
 
 def _moves(rows: list[int]) -> PlannerMoves:
@@ -38,3 +39,26 @@ def test_commands_between_moves_as_counted_by_hand(move_rows, command_rows, in_o
     commands = sorted(command_rows)
     got = happens_before(_moves(move_rows), np.asarray(commands, np.int64))
     assert got.tolist() == _by_hand(move_rows, commands)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.integers(0, 3), max_size=60), st.integers(1, 7), st.booleans(), st.integers(0, 2**32 - 1))
+def test_waypoint_times_summed_a_block_at_a_time_are_one_bincount(gaps, size, in_order, seed):
+    """Blocks cut only between waypoints give each waypoint the sum np.bincount gives, to the last bit."""
+    waypoint = np.cumsum(gaps).astype(np.int32)  # runs of moves per waypoint (an arc's chords), waypoints skipped
+    if not in_order:
+        np.random.default_rng(seed).shuffle(waypoint)
+    durations = np.random.default_rng(seed).random(waypoint.size) * 10.0 ** np.arange(waypoint.size) % 7
+    blocks = list(plan._whole_waypoints(waypoint, size))
+    assert [b.start for b in blocks[1:]] == [b.stop for b in blocks[:-1]]
+    assert sum(b.stop - b.start for b in blocks) == waypoint.size
+    for b in blocks[:-1] if in_order else []:  # no waypoint's moves split between two blocks
+        assert waypoint[b.stop - 1] != waypoint[b.stop]
+    n = int(waypoint.max()) + 3 if waypoint.size else 2
+    w = {"x": np.zeros(n), "motion": np.full(n, 2, np.uint8), "time": np.zeros(n), "feed": np.ones(n),
+         "distance": np.ones(n)}
+    result = PlanResult(*(np.zeros(waypoint.size) for _ in range(4)), durations, np.zeros(waypoint.size),
+                        np.zeros(waypoint.size))
+    moves = PlannedMoves(np.ones(waypoint.size), waypoint, waypoint, np.ones(waypoint.size))
+    expected = np.bincount(waypoint, weights=durations, minlength=n)
+    np.testing.assert_array_equal(plan.waypoint_times(w, moves, result).view(np.int64), expected.view(np.int64))

@@ -13,7 +13,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import os
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Iterator, Mapping
 
 import numpy as np
 
@@ -83,7 +83,8 @@ def run_planner(program: "EmulatedProgram", name: str, settings) -> Plan:
                 moves.planned() if isinstance(moves, PlannerMoves) else moves, result)
 
 
-def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMoves, result: PlanResult) -> np.ndarray:
+def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMoves,
+                   result: PlanResult | TrapezoidPlan) -> np.ndarray:
     """Per-waypoint planned time from per-move results.
 
     A waypoint's time is the sum of its moves' durations; a waypoint that
@@ -93,10 +94,12 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
     planner's crawl at its minimum speed.
     """
     n = w["x"].size
-    duration_t = result.duration_t
-    # (np.bincount of no moves gives integers, whatever the weights)
-    times = np.bincount(moves.waypoint, weights=duration_t, minlength=n).astype(np.float64, copy=False)
-    del duration_t
+    times = np.zeros(n)
+    waypoint = moves.waypoint
+    for sel in _whole_waypoints(waypoint):  # a block of moves at a time: no array of every move's duration
+        first = int(waypoint[sel].min())
+        summed = np.bincount(waypoint[sel] - first, weights=result.durations(sel))  # each in move order
+        times[first:first + summed.size] = summed
     has_moves = np.zeros(n, bool)
     has_moves[moves.waypoint] = True
     idle = np.flatnonzero(~has_moves)
@@ -105,6 +108,23 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
     unknown = (np.asarray(w["motion"]) >= 2) & ~(np.asarray(w["feed"], float) > 0) & (np.asarray(w["distance"]) > 0)
     times[unknown] = np.nan
     return times
+
+
+def _whole_waypoints(waypoint: np.ndarray, size: int = 1 << 16) -> Iterator[slice]:
+    """Blocks of about ``size`` moves, each holding all the moves of its waypoints (one block when the
+    moves are not in waypoint order)."""
+    m = waypoint.size
+    if m and not (waypoint[1:] >= waypoint[:-1]).all():
+        yield slice(0, m)
+        return
+    lo = 0
+    while lo < m:
+        hi = min(lo + size, m)
+        if hi < m:  # cut before the waypoint the block would split, or after it when it fills the block
+            cut = int(np.searchsorted(waypoint, waypoint[hi], "left"))
+            hi = cut if cut > lo else int(np.searchsorted(waypoint, waypoint[hi], "right"))
+        yield slice(lo, hi)
+        lo = hi
 
 
 def waypoint_speeds(plan: tuple[PlannedMoves, PlanResult], n: int) -> dict[str, np.ndarray]:

@@ -393,14 +393,15 @@ def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v
     return cruise_v2, next_start_v2
 
 
-def _move_points(x, y, z, de, motion, homing, distance):
-    """:func:`.moves.firmware_moves`' choice of moves and :func:`.moves._move_ends`' points, in two passes.
+def _move_points(x, y, z, de, motion, homing, distance, with_points):
+    """:func:`.moves.firmware_moves`' choice of moves and :class:`.points.MoveEnds`' points, in two passes.
 
     A waypoint is a move when it moves (``motion > 0``), is no homing move,
     and changes X, Y, Z or the extruder position (the running sum of ``de``,
-    as ``np.cumsum``) or is a full circle.  Returns the moves' waypoints, and
-    their start and end points: rows of one array of points when each move
-    starts where the one before ended (``chained``), else two arrays.
+    as ``np.cumsum``) or is a full circle.  Returns the moves' waypoints,
+    their start and end points (rows of one array of points when each move
+    starts where the one before ended, ``chained``, else two arrays; none
+    without ``with_points``) and ``chained``.
     """
     n = x.size
     is_move = np.zeros(n, np.bool_)
@@ -423,8 +424,9 @@ def _move_points(x, y, z, de, motion, homing, distance):
             lx, ly, lz, le = x[i], y[i], z[i], e
         px, py, pz, pe = x[i], y[i], z[i], e
     idx = np.empty(count, np.int64)
-    start = np.empty((count + 1 if chained else count, 4))
-    end = start[1:] if chained else np.empty((count, 4))
+    m = count if with_points else 0
+    start = np.empty((m + 1 if chained else m, 4))
+    end = start[1:] if chained else np.empty((m, 4))
     k = 0
     e = 0.0
     px = py = pz = pe = 0.0
@@ -432,15 +434,16 @@ def _move_points(x, y, z, de, motion, homing, distance):
         e = de[i] if i == 0 else e + de[i]
         if is_move[i]:
             idx[k] = i
-            if k == 0 or not chained:
-                if i == 0:
-                    start[k, 0] = start[k, 1] = start[k, 2] = start[k, 3] = 0.0
-                else:
-                    start[k, 0], start[k, 1], start[k, 2], start[k, 3] = px, py, pz, pe
-            end[k, 0], end[k, 1], end[k, 2], end[k, 3] = x[i], y[i], z[i], e
+            if with_points:
+                if k == 0 or not chained:
+                    if i == 0:
+                        start[k, 0] = start[k, 1] = start[k, 2] = start[k, 3] = 0.0
+                    else:
+                        start[k, 0], start[k, 1], start[k, 2], start[k, 3] = px, py, pz, pe
+                end[k, 0], end[k, 1], end[k, 2], end[k, 3] = x[i], y[i], z[i], e
             k += 1
         px, py, pz, pe = x[i], y[i], z[i], e
-    return idx, (start[:count] if chained else start), end, chained
+    return idx, (start[:m] if chained else start), end, chained
 
 
 def _marlin_trapezoids(move_d, accel, entry_v2, nominal_v2, exit_v2, start_v, cruise_v, end_v, accel_t, cruise_t,

@@ -54,8 +54,9 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
         Marlin's ``nominal_length`` flag: such a move always enters at its
         cap, and the next move's entry is not checked against it.
     reuse : bool, default: False
-        Write the reverse pass's bounds over ``max_entry_v2`` (a float64
-        array the caller no longer needs): one array fewer at the peak.
+        Write the reverse pass's bounds over ``max_entry_v2`` and the
+        forward pass's increments over ``delta_v2`` (float64 arrays the
+        caller no longer needs): two arrays fewer at the peak.
 
     Returns
     -------
@@ -79,15 +80,16 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     if nominal_length is not None:
         free |= nominal_length
     stop = rest_after if nominal_length is None else rest_after & ~nominal_length  # a nominal_length move: its cap
-    if reuse and isinstance(max_entry_v2, np.ndarray) and max_entry_v2.dtype == np.float64:
+    if reuse and _writable(max_entry_v2):
         bound = max_entry_v2
         np.minimum(bound, rest_v2 + delta_v2, out=bound, where=stop)
     else:
         bound = np.where(stop, np.minimum(max_entry_v2, rest_v2 + delta_v2), max_entry_v2)
-    del stop
+    del stop, max_entry_v2
     reverse_v2 = backward_min(bound, np.where(free, bound, delta_v2))
     del bound  # each array dropped as soon as it is used: the plan of a large program is memory-bound
-    forward_inc = delta_v2.copy()
+    forward_inc = delta_v2 if reuse and _writable(delta_v2) else delta_v2.copy()
+    del delta_v2
     cut = np.flatnonzero(free[:-1])
     del free
     forward_inc[cut] = reverse_v2[cut + 1]
@@ -98,6 +100,10 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     exit_v2[-1:] = rest_v2
     exit_v2[rest_after] = rest_v2
     return entry_v2, exit_v2
+
+
+def _writable(a) -> bool:
+    return isinstance(a, np.ndarray) and a.dtype == np.float64 and a.flags.writeable
 
 
 def trapezoid(move_d: np.ndarray, accel: np.ndarray, entry_v2: np.ndarray, nominal_v2: np.ndarray,

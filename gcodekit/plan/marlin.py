@@ -290,7 +290,7 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     """
     factor = speed_factor(op)
     moves = firmware_moves(op, factor, lambda travel, angle, radius, speed_v: arc_segments(
-        travel, angle, radius, config.max_arc_segment_mm, config.min_circle_segments))
+        travel, angle, radius, config.max_arc_segment_mm, config.min_circle_segments), gathered=True)
     n = len(moves)
     if n == 0:
         return moves, empty_result()
@@ -314,7 +314,7 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     # current block and next block junction speeds are guaranteed to always be at their maximum"
     nominal_length = nominal_speed_sqr <= minimum_planner_speed_sqr + delta_v2
     rest_after = np.r_[rest_before[1:], True]
-    entry_speed_sqr, exit_speed_sqr = lookahead(block["max_entry_speed_sqr"], delta_v2, rest_after,
+    entry_speed_sqr, exit_speed_sqr = lookahead(block.pop("max_entry_speed_sqr"), delta_v2, rest_after,
                                                 rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length,
                                                 reuse=True)
     del block, delta_v2, nominal_length, rest_after

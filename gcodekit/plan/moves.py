@@ -21,6 +21,7 @@ import numpy as np
 from ..emulate import arcs
 from ..parse.table import NAME_ID
 from .kernels import engine
+from .points import MoveEnds, chained
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -37,7 +38,9 @@ class PlannerMoves:
     Attributes
     ----------
     start, end : ndarray, shape (n, 4)
-        X, Y, Z and extruder position (mm) at both ends.
+        X, Y, Z and extruder position (mm) at both ends (or, from
+        ``firmware_moves(gathered=True)``, views that gather a slice of moves
+        when indexed: see :class:`.points.MoveEnds`).
     speed_v : ndarray, shape (n,)
         Requested speed (mm/s): the feed rate over 60 times the speed factor.
     row : ndarray of int32 (int64 past 2**31 rows)
@@ -57,10 +60,11 @@ class PlannerMoves:
 
     @property
     def axes_d(self) -> np.ndarray:
-        return self.end - self.start
+        return np.asarray(self.end) - np.asarray(self.start)
 
     def select(self, keep: np.ndarray) -> "PlannerMoves":
-        return PlannerMoves(self.start[keep], self.end[keep], self.speed_v[keep], self.row[keep], self.waypoint[keep])
+        return PlannerMoves(np.asarray(self.start)[keep], np.asarray(self.end)[keep], self.speed_v[keep],
+                            self.row[keep], self.waypoint[keep])
 
     def planned(self) -> "PlannedMoves":
         """What an operation keeps after planning: no end points, just each move's length."""
@@ -107,8 +111,12 @@ class PlanResult:
 
     @property
     def duration_t(self) -> np.ndarray:
-        duration_t = self.accel_t + self.cruise_t
-        duration_t += self.decel_t  # in place: one array fewer
+        return self.durations()
+
+    def durations(self, sel: slice = slice(None)) -> np.ndarray:
+        """Each move's time (of the moves ``sel``), s: ``accel_t + cruise_t + decel_t``."""
+        duration_t = self.accel_t[sel] + self.cruise_t[sel]
+        duration_t += self.decel_t[sel]  # in place: one array fewer
         return duration_t
 
     def phases(self, sel: slice | np.ndarray = slice(None)) -> "PlanResult":
@@ -269,7 +277,7 @@ def follows_kept_step(moves: PlannerMoves, kept: np.ndarray) -> np.ndarray:
 
 
 def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None,
-                   arc_segments: ArcRule | None = None) -> PlannerMoves:
+                   arc_segments: ArcRule | None = None, *, gathered: bool = False) -> PlannerMoves:
     """The straight moves of an emulated operation, arcs cut by ``arc_segments``.
 
     Parameters
@@ -282,6 +290,11 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
         Segment count from arc length, swept angle, radius and requested
         speed (see :data:`ArcRule`); None keeps each arc as one move along
         its chord (only for machines that do not segment).
+    gathered : bool, default: False
+        Give ``start`` and ``end`` as :class:`.points.MoveEnds` views that
+        gather a slice of moves from the waypoints when indexed, instead of
+        stored arrays, for a planner that reads them a block at a time (when
+        no arc is cut into chords).
     """
     w = op.waypoints
     n = w["x"].size
@@ -290,11 +303,12 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     # length and time are unknown, and firmware time estimates leave them out.
     homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
     compiled = engine(n)
+    e = np.cumsum(w["de"]) if gathered or compiled is None else None
     if compiled is not None:  # the same moves and points in one loop, without the temporaries below
-        idx, start, end, _ = compiled.move_points(w["x"], w["y"], w["z"], w["de"], w["motion"], homing, w["distance"])
+        idx, start, end, is_chained = compiled.move_points(w["x"], w["y"], w["z"], w["de"], w["motion"], homing,
+                                                           w["distance"], not gathered)
         idx = _narrow(idx, n)
     else:
-        e = np.cumsum(w["de"])
         columns = (w["x"], w["y"], w["z"], e)
         changed = np.zeros(n, bool)
         for col in columns:  # compare with the previous waypoint column by column
@@ -303,15 +317,19 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
         full_circle = (w["motion"] >= 3) & (w["distance"] > 0)  # ends where it started
         idx = _narrow(np.flatnonzero((w["motion"] > 0) & ~homing & (changed | full_circle)), n)
         del changed
-        start, end = _move_ends(columns, idx)
-        del e, columns
+        is_chained = chained(columns, idx)
     del homing
     speed = np.asarray(w["feed"], float)[idx] / 60.0
     if speed_factor is not None:
         speed *= speed_factor[idx]
     is_arc = w["motion"][idx] >= 3
     rows = _narrow(rows[idx], len(op.table))
-    if arc_segments is None or not is_arc.any():
+    segmenting = arc_segments is not None and bool(is_arc.any())
+    if e is not None:  # the points from the waypoint columns: gathered when asked, else stored
+        ends = MoveEnds((w["x"], w["y"], w["z"], e), idx, is_chained)
+        start, end = (ends.start, ends.end) if gathered and not segmenting else ends.arrays()
+        del ends, e
+    if not segmenting:
         return PlannerMoves(start, end, speed, rows, idx)
     return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows, arc_segments)
 
@@ -347,36 +365,6 @@ def _chords_within_limit(op, chords: np.ndarray, angle: np.ndarray, rows: np.nda
     op.diagnostics.report(int(op.table.line[rows[worst]]), 1, f"arcs would be cut into {total:,.0f} moves, more than "
                           f"max_motions={op.max_motions:,}; {what}", kind="limit")
     return counts
-
-
-def _move_ends(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Start and end (X, Y, Z, E) of the moves ending at waypoints ``idx``.
-
-    A move starts where the waypoint before it ended.  When every move
-    starts where the previous move ended (no homing or position jump
-    between them, the usual case) both are views of one array of points,
-    half the memory of two.
-    """
-    before = np.maximum(idx - 1, 0)
-    # where a move's waypoint follows the previous move's, its start is that move's end; compare the rest
-    # (and every one when a column holds NaN, which equals nothing)
-    gaps = np.flatnonzero(before[1:] != idx[:-1])
-    chained = all(np.array_equal(col[before[1:][gaps]], col[idx[:-1][gaps]]) if not np.isnan(col).any() else
-                  np.array_equal(col[before[1:]], col[idx[:-1]]) for col in columns)
-    if chained:
-        points = np.empty((idx.size + 1, 4))
-        start, end = points[:-1], points[1:]
-    else:
-        start, end = np.empty((idx.size, 4)), np.empty((idx.size, 4))
-    for k, col in enumerate(columns):
-        end[:, k] = col[idx]
-        if not chained:
-            start[:, k] = col[before]
-        elif idx.size:
-            start[0, k] = col[before[0]]
-    if idx.size and idx[0] == 0:
-        start[0] = 0.0
-    return start, end
 
 
 def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc_segments) -> PlannerMoves:

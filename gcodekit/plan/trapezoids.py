@@ -113,13 +113,17 @@ class TrapezoidPlan:
     @property
     def duration_t(self) -> np.ndarray:
         """Each move's time, s: ``accel_t + cruise_t + decel_t``, summed a block at a time."""
-        compiled = self._compiled(slice(None), (), duration=True)
+        return self.durations()
+
+    def durations(self, sel: slice = slice(None)) -> np.ndarray:
+        """:attr:`duration_t` of the moves ``sel``, computed for them alone."""
+        compiled = self._compiled(sel, (), duration=True)
         if compiled is not None:
             return compiled[1]
-        n = len(self)
-        out = np.empty(n)
-        for lo in range(0, n, BLOCK):
-            s = slice(lo, min(lo + BLOCK, n))
+        first, stop, _ = sel.indices(len(self))
+        out = np.empty(max(stop - first, 0))
+        for lo in range(first, stop, BLOCK):
+            s = slice(lo, min(lo + BLOCK, stop))
             r = self._compute(("accel_t", "cruise_t", "decel_t"), s)
-            out[s] = r.accel_t + r.cruise_t + r.decel_t
+            out[lo - first:s.stop - first] = r.accel_t + r.cruise_t + r.decel_t
         return out
