@@ -37,7 +37,7 @@ from ..plan import machine_options as firmware_options
 from ..plan import planner_settings, run_planner
 from ..read import Blocks
 from ..syntax import Flavor
-from .assemble import concat_waypoints, empty_table, new_machine, raise_first_run, warn_implausible_time
+from .assemble import WaypointJoiner, empty_table, new_machine, raise_first_run, warn_implausible_time
 from .program import Program, as_program, check_program_end, note_weak_detection, progress_bar, quote_diagnostics, resolve
 from .source import program_blocks, restore_line_numbers
 
@@ -224,13 +224,14 @@ def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: 
     machine_diagnostics = Diagnostics(program.name, "lenient") if diagnostics.mode == "strict" else diagnostics
     machine_diagnostics.elsewhere = diagnostics.elsewhere
     m = new_machine(fl, config, machine_diagnostics, limits)
-    tables, waypoints, n_lines = [], [], 0
+    tables, n_lines = [], 0
+    waypoints = WaypointJoiner()
 
     def emulate(blocks: Blocks, lines: int) -> None:
         nonlocal n_lines
         table = parser.parse(blocks)
         tables.append(table)
-        waypoints.append(m.run(table))
+        waypoints.add(m.run(table), len(table))
         n_lines += lines
 
     reading_error = None
@@ -243,17 +244,15 @@ def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: 
         reading_error = exc
     if bar is not None:
         bar.set_postfix_str(f"joining {n_lines:,} lines")
-    sizes = [len(t) for t in tables]
     table = CommandTable.concat(tables) if tables else empty_table(parser, program)
     if not tables:
-        waypoints, sizes = [m.run(table)], [0]
+        waypoints.add(m.run(table), 0)
     if fl.percent_delimiter and program.path is not None and not program.preprocessed and reading_error is None:
         check_program_end(program, table, n_lines, machine_diagnostics)  # rs274 finds it after the last line ran
     op = OPERATION_CLASSES[config.process](
-        table, concat_waypoints(waypoints, sizes), file=program.name, flavor=fl, machine=config,
+        table, waypoints.finish(), file=program.name, flavor=fl, machine=config,
         diagnostics=machine_diagnostics, n_lines=n_lines, max_motions=limits.max_motions)
     tables.clear()
-    waypoints.clear()
     release_freed_memory()  # the reader's per-chunk garbage, before the planner's arrays
     return op, reading_error, m
 

@@ -7,15 +7,15 @@ import numpy as np
 from ..emulate.machine import Machine
 from ..emulate.presets import MachineConfig
 from ..errors import Diagnostics, GcodeError
+from ..growing import GrowingColumn
 from ..limits import PLAUSIBLE_TIME_S, Limits
-from ..memory import release_freed_memory
 from ..model.operation import Operation
 from ..parse import CommandTable, GcodeParser
 from ..read import Blocks
 from ..syntax import Flavor
 from .program import Program, quote_diagnostics
 
-__all__ = ["new_machine", "empty_table", "concat_waypoints", "raise_first_run", "warn_implausible_time"]
+__all__ = ["new_machine", "empty_table", "WaypointJoiner", "raise_first_run", "warn_implausible_time"]
 
 
 def new_machine(flavor: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits = Limits()) -> Machine:
@@ -29,25 +29,77 @@ def empty_table(parser: GcodeParser, program: Program) -> CommandTable:
     return parser.parse(Blocks.empty(program.name))
 
 
-def concat_waypoints(parts: list[dict], sizes: list[int]) -> dict[str, np.ndarray]:
-    """Join per-chunk waypoint columns, one column at a time to bound memory."""
-    if len(parts) == 1:
-        return parts[0]
-    shift = np.cumsum([0] + sizes[:-1])
-    for p, s in zip(parts, shift):  # each chunk counts its commands from 0
-        p["command"] = p["command"] + np.int32(s)  # int32: max_motions keeps the rows far below 2**31
-    out = {}
-    for key in list(parts[0]):
-        cols = [p.pop(key) for p in parts]
-        first = cols[0][0] if cols[0].size else None
-        if key != "command" and first is not None and all(c.strides == (0,) for c in cols) and all(
-                (c[0] == first) or (c[0] != c[0] and first != first) for c in cols if c.size):
-            out[key] = np.broadcast_to(first, (sum(c.size for c in cols),))
-        else:
-            out[key] = np.concatenate(cols)
-        del cols
-        release_freed_memory()  # the chunks' column, freed amid the live ones: give its pages back now
-    return out
+class WaypointJoiner:
+    """The waypoint columns of a program's chunks, joined as each chunk is emulated.
+
+    Gives what joining them all at the end would: a single chunk's columns
+    as they are; otherwise each column in one array (a
+    :class:`~gcodekit.growing.GrowingColumn`: no second copy of the
+    program's columns, no page touched twice), or a zero-stride view of the
+    first chunk's value when every chunk holds one value equal to it, and
+    ``command`` counting the rows of the whole program.
+    """
+
+    def __init__(self) -> None:
+        self._first: tuple[dict[str, np.ndarray], int] | None = None  # a lone chunk is kept as it is
+        self._keys: list[str] = []
+        self._rows = 0  # command rows of the chunks joined so far
+        self._size = 0  # their waypoints
+        self._columns: dict[str, GrowingColumn] = {}
+        #: key -> (value, waypoints) of each chunk so far, while all are zero-stride views of equal values
+        self._constant: dict[str, list[tuple[np.generic, int]]] = {}
+
+    def add(self, part: dict[str, np.ndarray], rows: int) -> None:
+        """The next chunk's columns (its ``command`` counting from 0) and its number of command rows."""
+        if not self._keys and self._first is None:
+            self._first = (part, rows)
+            return
+        if self._first is not None:  # a second chunk: from now on, joined
+            (first, first_rows), self._first = self._first, None
+            self._keys = list(first)
+            self._constant = {k: [] for k in self._keys if k != "command" and first[k].size}
+            self._take(first, first_rows)
+        self._take(part, rows)
+
+    def _take(self, part: dict[str, np.ndarray], rows: int) -> None:
+        for key in self._keys:
+            col = part[key]
+            if key == "command":
+                self._column(key, col.dtype).append(col + np.int32(self._rows))  # int32: max_motions bounds the rows
+                continue
+            runs = self._constant.get(key)
+            if runs is not None and col.strides == (0,) and (not col.size or not runs or _same(col[0], runs[0][0])):
+                runs.append((col[0] if col.size else runs[0][0], col.size))
+                continue
+            if runs is not None:  # no longer one value: the chunks so far written out, each with its own
+                del self._constant[key]
+                column = self._column(key, col.dtype)
+                for value, count in runs:
+                    column.fill(value, count)
+            self._column(key, col.dtype).append(col)
+        self._size += part["command"].size
+        self._rows += rows
+
+    def _column(self, key: str, dtype: np.dtype) -> GrowingColumn:
+        column = self._columns.get(key)
+        if column is None:
+            column = self._columns[key] = GrowingColumn(dtype)
+        return column
+
+    def finish(self) -> dict[str, np.ndarray]:
+        """The joined columns (the joiner is spent)."""
+        if self._first is not None:
+            return self._first[0]
+        out = {}
+        for key in self._keys:
+            runs = self._constant.get(key)
+            out[key] = np.broadcast_to(runs[0][0], (self._size,)) if runs is not None else self._columns[key].finish()
+        return out
+
+
+def _same(value, first) -> bool:
+    """Equal, or both NaN."""
+    return bool(value == first or (value != value and first != first))
 
 
 def raise_first_run(op: Operation, program: Program, reading_error: GcodeError | None) -> None:

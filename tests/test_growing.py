@@ -1,0 +1,111 @@
+"""Columns joined as the chunks come: ``growing.GrowingColumn`` and the pipeline's ``WaypointJoiner``.
+
+The reference is what joining every chunk at the end gives: ``np.concatenate``
+of the chunks, and a zero-stride view of the first chunk's value when every
+chunk is a zero-stride view of one value (equal, or NaN).
+"""
+
+from __future__ import annotations
+
+import mmap
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gcodekit import growing
+from gcodekit.growing import GrowingColumn
+from gcodekit.pipeline.assemble import WaypointJoiner
+
+
+def test_a_column_grows_past_its_first_capacity_without_losing_a_value():
+    column = GrowingColumn(np.float64)
+    pieces = [np.arange(k * 1000, (k + 1) * 1000, dtype=np.float64) for k in range(1500)]  # 12 MB > 4 MB first map
+    for piece in pieces:
+        column.append(piece)
+    column.fill(-0.0, 3)
+    out = column.finish()
+    np.testing.assert_array_equal(out[:-3], np.arange(1_500_000, dtype=np.float64))
+    assert np.signbit(out[-3:]).all() and out.dtype == np.float64 and out.flags.writeable
+    assert len(column) == 0 and column.finish().size == 0
+
+
+def test_a_wider_dtype_promotes_the_column_as_concatenate_would():
+    column = GrowingColumn(np.int32)
+    column.append(np.array([1, 2], np.int32))
+    column.append(np.array([0.5]))
+    out = column.finish()
+    assert out.dtype == np.float64 and out.tolist() == [1.0, 2.0, 0.5]
+
+
+def test_where_a_map_cannot_grow_the_column_copies(monkeypatch):
+    class Fixed(mmap.mmap):
+        def resize(self, size):
+            raise SystemError("mmap: resizing not available--no mremap()")
+
+    monkeypatch.setattr(growing.mmap, "mmap", Fixed)
+    column = GrowingColumn(np.uint8)
+    for k in range(10):
+        column.append(np.full(1 << 20, k, np.uint8))
+    out = column.finish()
+    assert out.size == 10 << 20 and np.array_equal(np.unique(out), np.arange(10))
+
+
+def _joined_at_the_end(parts: list[dict], sizes: list[int]) -> dict:
+    """The reference: every chunk kept, then each column joined (the pipeline's way before WaypointJoiner)."""
+    if len(parts) == 1:
+        return parts[0]
+    shift = np.cumsum([0] + sizes[:-1])
+    out = {}
+    for key in parts[0]:
+        cols = [p[key] for p in parts]
+        if key == "command":
+            out[key] = np.concatenate([c + np.int32(s) for c, s in zip(cols, shift)])
+            continue
+        first = cols[0][0] if cols[0].size else None
+        if first is not None and all(c.strides == (0,) for c in cols) and all(
+                c[0] == first or (c[0] != c[0] and first != first) for c in cols if c.size):
+            out[key] = np.broadcast_to(first, (sum(c.size for c in cols),))
+        else:
+            out[key] = np.concatenate(cols)
+    return out
+
+
+values = st.sampled_from([0.0, -0.0, 1.5, np.nan, 2.0])
+chunk = st.tuples(st.integers(0, 5), st.booleans(), values, values)  # size, constant?, its value, another
+
+
+def _part(size: int, constant: bool, value: float, other: float) -> dict:
+    z = np.broadcast_to(np.float64(value), (size,)) if constant and size else np.r_[np.full(size, value)[1:], other][:size]
+    tool = np.broadcast_to(np.int32(3), (size,)) if size else np.empty(0, np.int32)
+    return {"x": np.arange(size, dtype=np.float64) * other, "z": z, "tool": tool,
+            "command": np.arange(size, dtype=np.int32)}
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(chunk, min_size=1, max_size=6), st.lists(st.integers(0, 4), min_size=6, max_size=6))
+def test_waypoints_joined_as_they_come_are_the_ones_joined_at_the_end(chunks, extra_rows):
+    parts = [_part(*c) for c in chunks]
+    sizes = [p["command"].size + r for p, r in zip(parts, extra_rows)]  # rows: a chunk has comments too
+    joiner = WaypointJoiner()
+    for p, rows in zip(parts, sizes):
+        joiner.add({k: v.copy() if v.strides != (0,) and v.size else v for k, v in p.items()}, rows)
+    got, expected = joiner.finish(), _joined_at_the_end(parts, sizes)
+    assert list(got) == list(expected)
+    for key in expected:
+        assert got[key].dtype == expected[key].dtype, key
+        if expected[key].size:
+            assert (got[key].strides == (0,)) == (expected[key].strides == (0,)), key
+        bits = [np.ascontiguousarray(a).view(np.uint8) for a in (got[key], expected[key])]  # -0.0 is not 0.0
+        np.testing.assert_array_equal(*bits)
+
+
+@pytest.mark.parametrize("n", [0, 1])
+def test_no_chunk_or_one_chunk(n):
+    joiner = WaypointJoiner()
+    parts = [_part(3, True, 1.0, 2.0) for _ in range(n)]
+    for p in parts:
+        joiner.add(p, 3)
+    out = joiner.finish()
+    assert out == {} if n == 0 else out is parts[0]
