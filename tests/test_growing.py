@@ -1,4 +1,4 @@
-"""Columns joined as the chunks come: ``growing.GrowingColumn`` and the pipeline's ``WaypointJoiner``.
+"""Columns joined as the chunks come: ``growing.GrowingColumn``, ``parse.join.TableJoiner`` and ``WaypointJoiner``.
 
 The reference is what joining every chunk at the end gives: ``np.concatenate``
 of the chunks, and a zero-stride view of the first chunk's value when every
@@ -15,8 +15,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gcodekit import growing
+from gcodekit.errors import Diagnostics
 from gcodekit.growing import GrowingColumn
+from gcodekit.parse import GcodeParser
+from gcodekit.parse.join import TableJoiner
+from gcodekit.parse.table import CommandTable, SparseColumn
 from gcodekit.pipeline.assemble import WaypointJoiner
+from gcodekit.read import read_text
+from gcodekit.syntax import load_flavor
 
 
 def test_a_column_grows_past_its_first_capacity_without_losing_a_value():
@@ -109,3 +115,80 @@ def test_no_chunk_or_one_chunk(n):
         joiner.add(p, 3)
     out = joiner.finish()
     assert out == {} if n == 0 else out is parts[0]
+
+
+def _tables_joined_at_the_end(parts: list[CommandTable]) -> CommandTable:
+    """The reference: every chunk's table kept, then each column joined (the pipeline's way before TableJoiner)."""
+    if len(parts) == 1:
+        return parts[0].compact()
+    sizes = [len(p) for p in parts]
+    shift = np.cumsum([0] + sizes[:-1])
+    n = sum(sizes)
+    params = {}
+    for letter in sorted({k for p in parts for k in p.params}):
+        cols = [p.params.get(letter) for p in parts]
+        if all(c is None or isinstance(c, SparseColumn) for c in cols):
+            params[letter] = SparseColumn(np.concatenate([c.rows + s for c, s in zip(cols, shift) if c is not None]),
+                                          np.concatenate([c.values for c in cols if c is not None]), n)
+        else:
+            params[letter] = np.concatenate([np.full(size, np.nan) if c is None else (
+                c.dense() if isinstance(c, SparseColumn) else c) for c, size in zip(cols, sizes)])
+    offsets, base = [parts[0].comment_offsets], parts[0].comment_offsets[-1]
+    for p in parts[1:]:
+        offsets.append(p.comment_offsets[1:] + base)
+        base += p.comment_offsets[-1]
+    return CommandTable(
+        **{name: np.concatenate([getattr(p, name) for p in parts])
+           for name in ("line", "kind", "letter", "number", "name", "motion")},
+        params=params,
+        comment_rows=np.concatenate([p.comment_rows + s for p, s in zip(parts, shift)]),
+        comment_offsets=np.concatenate(offsets), comment_data=b"".join(p.comment_data for p in parts),
+        named={k + int(s): v for p, s in zip(parts, shift) for k, v in p.named.items()},
+        texts={k + int(s): v for p, s in zip(parts, shift) for k, v in p.texts.items()},
+        deleted=np.concatenate([p.deleted + s for p, s in zip(parts, shift)]),
+        profiles={k + int(s): v for p, s in zip(parts, shift) for k, v in p.profiles.items()},
+    ).compact()
+
+
+LINES = ["G1 X1.5 Y2 E0.1 F1200", "G1 X3 Y-0", "G0 Z0.3", "M104 S200", "; a comment", "M117 hello there",
+         "/G1 X9 Y9", "T1", "G1 E-0.8 F2400", "G92 E0", "M106 S255 P1", "", "G4 P100 ; dwell"]
+
+
+def _chunk_tables(chunks: list[list[int]], sparse: list[bool]) -> list[CommandTable]:
+    parser = GcodeParser(load_flavor("marlin"), Diagnostics())
+    tables = []
+    for lines, compact in zip(chunks, sparse):
+        table = parser.parse(read_text("".join(LINES[k] + "\n" for k in lines), "marlin"))
+        tables.append(table.compact() if compact else table)  # a chunk's own sparse columns
+    return tables
+
+
+def _table_fields(t: CommandTable) -> dict:
+    out = {name: np.asarray(getattr(t, name)) for name in
+           ("line", "kind", "letter", "number", "name", "motion", "comment_rows", "comment_offsets", "deleted")}
+    for letter, c in t.params.items():
+        out[letter] = (c.rows, c.values, c.size) if isinstance(c, SparseColumn) else c
+    out.update(letters=list(t.params), data=t.comment_data, named=t.named, texts=t.texts, profiles=t.profiles)
+    return out
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.lists(st.integers(0, len(LINES) - 1), max_size=8), min_size=1, max_size=5),
+       st.lists(st.booleans(), min_size=5, max_size=5))
+def test_tables_joined_as_they_come_are_the_ones_joined_at_the_end(chunks, sparse):
+    joiner = TableJoiner()
+    for table in _chunk_tables(chunks, sparse):
+        joiner.add(table)
+    got = _table_fields(joiner.finish())
+    expected = _table_fields(_tables_joined_at_the_end(_chunk_tables(chunks, sparse)))
+    assert got.keys() == expected.keys() and got["letters"] == expected["letters"]
+    for key, value in expected.items():
+        if isinstance(value, np.ndarray):
+            assert got[key].dtype == value.dtype, key
+            np.testing.assert_array_equal(got[key].view(np.uint8), value.view(np.uint8), err_msg=key)
+        elif isinstance(value, tuple):  # a sparse column
+            assert isinstance(got[key], tuple) and got[key][2] == value[2], key
+            for a, b in zip(got[key][:2], value[:2]):
+                assert a.dtype == b.dtype and np.array_equal(a.view(np.uint8), b.view(np.uint8)), key
+        else:
+            assert got[key] == value, key

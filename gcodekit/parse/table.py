@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..lathe_profile import LatheProfile
-from ..memory import release_freed_memory
 from ..syntax.flavor import COMMANDS, code_label
 from .commands import COMMAND_CLASSES, Command, Kind
 
@@ -213,64 +212,3 @@ class CommandTable:
                 rows = np.flatnonzero(given)
                 self.params[letter] = SparseColumn(rows.astype(np.int64), col[rows], n)
         return self
-
-    @classmethod
-    def concat(cls, parts: list["CommandTable"]) -> "CommandTable":
-        """Join consecutive chunks, one column at a time to bound memory."""
-        if len(parts) == 1:
-            return parts[0].compact()
-        sizes = [len(p) for p in parts]
-        shift = np.cumsum([0] + sizes[:-1])
-        letters = sorted({k for p in parts for k in p.params})
-        params: dict[str, np.ndarray | SparseColumn] = {}
-        n = sum(sizes)
-        for letter in letters:
-            cols = [p.params.pop(letter, None) for p in parts]
-            if all(c is None or isinstance(c, SparseColumn) for c in cols):
-                params[letter] = SparseColumn(
-                    np.concatenate([c.rows + s for c, s in zip(cols, shift) if c is not None]),
-                    np.concatenate([c.values for c in cols if c is not None]), n)
-            else:
-                params[letter] = np.concatenate([
-                    np.full(size, np.nan) if c is None else (c.dense() if isinstance(c, SparseColumn) else c)
-                    for c, size in zip(cols, sizes)])
-            del cols
-            release_freed_memory()  # the chunks' column, freed amid live ones: its pages back now
-        named = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.named.items()}
-        texts = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.texts.items()}
-        profiles = {k + int(s): v for p, s in zip(parts, shift) for k, v in p.profiles.items()}
-        table = cls(
-            line=_cat(parts, "line"),
-            kind=_cat(parts, "kind"),
-            letter=_cat(parts, "letter"),
-            number=_cat(parts, "number"),
-            name=_cat(parts, "name"),
-            motion=_cat(parts, "motion"),
-            params=params,
-            comment_rows=np.concatenate([p.comment_rows + s for p, s in zip(parts, shift)]),
-            comment_offsets=_concat_offsets([p.comment_offsets for p in parts]),
-            comment_data=b"".join(p.comment_data for p in parts),
-            named=named,
-            texts=texts,
-            deleted=np.concatenate([p.deleted + s for p, s in zip(parts, shift)]),
-            profiles=profiles,
-        )
-        assert len(table) == n
-        return table.compact()
-
-
-def _concat_offsets(offsets: list[np.ndarray]) -> np.ndarray:
-    out = [offsets[0]]
-    base = offsets[0][-1]
-    for o in offsets[1:]:
-        out.append(o[1:] + base)
-        base += o[-1]
-    return np.concatenate(out)
-
-
-def _cat(parts: list[CommandTable], attr: str) -> np.ndarray:
-    out = np.concatenate([getattr(p, attr) for p in parts])
-    for p in parts:
-        setattr(p, attr, None)
-    release_freed_memory()
-    return out

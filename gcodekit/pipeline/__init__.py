@@ -32,7 +32,8 @@ from ..memory import release_freed_memory
 from ..model import OPERATION_CLASSES, Operation
 from ..model.derived import laser_power
 from ..model.filament import relative_e_suspect, stated_diameter
-from ..parse import CommandTable, GcodeParser
+from ..parse import GcodeParser
+from ..parse.join import TableJoiner
 from ..plan import machine_options as firmware_options
 from ..plan import planner_settings, run_planner
 from ..read import Blocks
@@ -58,12 +59,14 @@ def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None,
     diagnostics = Diagnostics(program.name, mode)
     note_weak_detection(detection, diagnostics)
     parser = GcodeParser(fl, diagnostics)
-    parts, n_lines = [], 0
+    joiner, n_lines = TableJoiner(), 0
     for blocks, lines in program_blocks(program, fl, diagnostics):
-        parts.append(parser.parse(blocks))
+        joiner.add(parser.parse(blocks))
         n_lines += lines
     cls = OPERATION_CLASSES[config.process]
-    table = CommandTable.concat(parts) if parts else empty_table(parser, program)
+    table = joiner.finish()
+    if table is None:
+        table = empty_table(parser, program)
     restore_line_numbers(table, diagnostics)
     return cls(table, file=program.name, flavor=fl, machine=config, diagnostics=diagnostics, n_lines=n_lines)
 
@@ -224,14 +227,13 @@ def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: 
     machine_diagnostics = Diagnostics(program.name, "lenient") if diagnostics.mode == "strict" else diagnostics
     machine_diagnostics.elsewhere = diagnostics.elsewhere
     m = new_machine(fl, config, machine_diagnostics, limits)
-    tables, n_lines = [], 0
-    waypoints = WaypointJoiner()
+    tables, waypoints, n_lines = TableJoiner(), WaypointJoiner(), 0
 
     def emulate(blocks: Blocks, lines: int) -> None:
         nonlocal n_lines
         table = parser.parse(blocks)
-        tables.append(table)
         waypoints.add(m.run(table), len(table))
+        tables.add(table)
         n_lines += lines
 
     reading_error = None
@@ -244,15 +246,15 @@ def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: 
         reading_error = exc
     if bar is not None:
         bar.set_postfix_str(f"joining {n_lines:,} lines")
-    table = CommandTable.concat(tables) if tables else empty_table(parser, program)
-    if not tables:
+    table = tables.finish()
+    if table is None:
+        table = empty_table(parser, program)
         waypoints.add(m.run(table), 0)
     if fl.percent_delimiter and program.path is not None and not program.preprocessed and reading_error is None:
         check_program_end(program, table, n_lines, machine_diagnostics)  # rs274 finds it after the last line ran
     op = OPERATION_CLASSES[config.process](
         table, waypoints.finish(), file=program.name, flavor=fl, machine=config,
         diagnostics=machine_diagnostics, n_lines=n_lines, max_motions=limits.max_motions)
-    tables.clear()
     release_freed_memory()  # the reader's per-chunk garbage, before the planner's arrays
     return op, reading_error, m
 
