@@ -474,6 +474,10 @@ def _config(root: Path, Config):
     return config
 
 
+#: What nbgrader logs when a kernel could not bind the ports picked for it
+KERNEL_LOST_PORT_RACE = "Kernel died before replying to kernel_info"
+
+
 def _grade(root: Path, student: str, NbGraderAPI, Config) -> None:
     """In a process of its own: nbgrader's autograde and feedback for one student of the course in ``root``."""
     import sys
@@ -520,16 +524,26 @@ def _graded_course(root: Path, NbGraderAPI, Config):
     from nbgrader.api import Gradebook
 
     spawn = multiprocessing.get_context("spawn")
-    running = {}
-    for student in STUDENTS:
+
+    def start(student: str):
         copy = root.parent / f"{root.name}-{student}"
+        shutil.rmtree(copy, ignore_errors=True)
         shutil.copytree(root, copy, ignore=shutil.ignore_patterns(*[s for s in STUDENTS if s != student]))
-        running[student] = copy, spawn.Process(target=_grade, args=(copy, student, NbGraderAPI, Config))
-        running[student][1].start()
+        process = spawn.Process(target=_grade, args=(copy, student, NbGraderAPI, Config))
+        process.start()
+        return copy, process
+
+    running = {student: start(student) for student in STUDENTS}
     scores = {}
-    for student, (copy, process) in running.items():
+    for student in STUDENTS:
+        copy, process = running[student]
         process.join()
         log = copy / "grading.log"
+        if process.exitcode != 0 and log.exists() and KERNEL_LOST_PORT_RACE in log.read_text():
+            # jupyter_client picks a kernel's free ports before the kernel binds them: a kernel of another
+            # student's process, started in between, may take one ("Address already in use"); grade again, alone
+            copy, process = start(student)
+            process.join()
         assert process.exitcode == 0, log.read_text()[-3000:] if log.exists() else "see the captured stderr"
         for folder in ("autograded", "feedback"):
             shutil.copytree(copy / folder / student, root / folder / student)
