@@ -222,6 +222,28 @@ def test_gathered_move_points_are_the_stored_ones(text, name):
         assert_bits_equal(getattr(stored, field), getattr(gathered, field), field)
 
 
+@pytest.mark.parametrize("text", [
+    "G1 X1 Y2 E0.5 F600\nG1 X3 E1\nG1 E1.5\nG1 X-0 Y-0\nG1 Z0.3\nG1 X2 Y2 Z0.6 E2\n",
+    "G28\nG1 X0 Y0 F600\nG1 X10 E1\nG1 X10\nG1 E2\nG92 X0\nG1 X5 E3\nG28 X\nG1 X3 Y3\nG1 Z0.3\n",
+])
+def test_klippers_compiled_set_up_reads_gathered_points_as_stored_ones(text):
+    from gcodekit.plan import klipper
+
+    op = gcodekit.gcode_to_operation(text, "klipper", plan=False)
+    config = klipper.KlipperConfig()
+    rows, limits = klipper._velocity_limits(op, config)
+    out = []
+    for gathered in (False, True):
+        moves = moves_module.firmware_moves(op, gathered=gathered)
+        flush = np.zeros(len(moves), bool)
+        flush[0] = True
+        out.append(klipper._compiled_moves(kernels.compiled(), moves, rows, limits, config, flush))
+    (stored, stored_junction), (got, got_junction) = out
+    for key in stored:
+        assert_bits_equal(stored[key], got[key], key)
+    assert_bits_equal(stored_junction, got_junction, "junction")
+
+
 def test_gathered_points_of_a_program_with_arcs_are_stored_chords():
     op = gcodekit.gcode_to_operation("G1 X1 Y0 F600\nG2 X-1 Y0 I-1 J0 E1\nG1 X0\n", "marlin", plan=False)
     cut = lambda travel, *_: np.maximum(np.floor(travel / 0.5), 1.0)  # noqa: E731

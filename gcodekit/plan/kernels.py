@@ -214,12 +214,15 @@ def _classic_jerk(dx, dy, dz, de, speed_per_mm, nominal_speed, jx, jy, jz, je, r
     return vmax
 
 
-def _klipper_moves(start, end, speed_v, row, flush, limit_rows, max_velocity, max_accel, square_corner_velocity,
-                   minimum_cruise_ratio, initial, z_velocity, z_accel, e_velocity, e_accel, corner_velocity,
-                   extrude_only_accel, no_limit_v2):
+def _klipper_moves(start, end, gathered, wx, wy, wz, we, idx, chained, speed_v, row, flush, limit_rows, max_velocity,
+                   max_accel, square_corner_velocity, minimum_cruise_ratio, initial, z_velocity, z_accel, e_velocity,
+                   e_accel, corner_velocity, extrude_only_accel, no_limit_v2):
     """:func:`.klipper._move_block` over all moves: Move.__init__, limit_speed and calc_junction.
 
-    The limits in force come from ``limit_rows`` (sorted) and their columns,
+    The moves' points are ``start`` and ``end``, or, when ``gathered``, the
+    waypoint columns ``wx, wy, wz, we`` at the moves' waypoints ``idx`` (as
+    :class:`.points.MoveEnds` takes them, ``chained`` or not).  The limits
+    in force come from ``limit_rows`` (sorted) and their columns,
     ``initial`` (max_velocity, max_accel, square_corner_velocity,
     minimum_cruise_ratio) before the first, as :func:`.moves.in_force`.
     Returns move_d, accel, max_cruise_v2, delta_v2, mcr_delta_v2, cap and junction.
@@ -250,10 +253,18 @@ def _klipper_moves(start, end, speed_v, row, flush, limit_rows, max_velocity, ma
             max_v, max_a, scv, mcr = initial[0], initial[1], initial[2], initial[3]
         jd = scv * scv * sqrt2_minus_1 / max_a
         mcr_pseudo_accel = max_a * (1.0 - mcr)
-        dx = end[i, 0] - start[i, 0]
-        dy = end[i, 1] - start[i, 1]
-        dz = end[i, 2] - start[i, 2]
-        de = end[i, 3] - start[i, 3]
+        if gathered:
+            w = idx[i]
+            v = idx[i - 1] if chained and i > 0 else w - 1  # the waypoint the move starts from
+            if v < 0:
+                dx, dy, dz, de = wx[w] - 0.0, wy[w] - 0.0, wz[w] - 0.0, we[w] - 0.0
+            else:
+                dx, dy, dz, de = wx[w] - wx[v], wy[w] - wy[v], wz[w] - wz[v], we[w] - we[v]
+        else:
+            dx = end[i, 0] - start[i, 0]
+            dy = end[i, 1] - start[i, 1]
+            dz = end[i, 2] - start[i, 2]
+            de = end[i, 3] - start[i, 3]
         move_d = np.sqrt((dx * dx + dy * dy) + dz * dz)
         kinematic = move_d >= 1e-9
         if not kinematic:

@@ -203,7 +203,8 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
     """Plan an emulated operation as Klipper would; one result per firmware move."""
     factor = speed_factor(op)
     # gcode_arcs.py: chords of at most `resolution` mm
-    moves = firmware_moves(op, factor, lambda mm, *_: np.maximum(np.floor(mm / config.arc_resolution), 1.0))
+    moves = firmware_moves(op, factor, lambda mm, *_: np.maximum(np.floor(mm / config.arc_resolution), 1.0),
+                           gathered=True)
     n = len(moves)
     if n == 0:
         empty = np.zeros(0)
@@ -250,9 +251,15 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
 def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict, np.ndarray]:
     """What :func:`_move_block` computes, for all moves in one compiled loop."""
     names = ("max_velocity", "max_accel", "square_corner_velocity", "minimum_cruise_ratio")
+    ends = getattr(moves.start, "ends", None)  # a MoveEnds when the points are gathered from the waypoints
+    if ends is None:
+        points = (np.ascontiguousarray(moves.start, float), np.ascontiguousarray(moves.end, float), False,
+                  *([np.zeros(0)] * 4), np.zeros(0, np.int32), False)
+    else:
+        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, *(np.asarray(c, float) for c in ends.columns),
+                  ends.idx, ends.chained)
     out = compiled.klipper_moves(
-        np.ascontiguousarray(moves.start, float), np.ascontiguousarray(moves.end, float),
-        np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row), flush,
+        *points, np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row), flush,
         np.ascontiguousarray(rows, np.int64), *(np.ascontiguousarray(limits[k], float) for k in names),
         np.array([float(getattr(config, k)) for k in names]), float(config.max_z_velocity or config.max_velocity),
         float(config.max_z_accel or config.max_accel), float(config.max_e_velocity), float(config.max_e_accel),

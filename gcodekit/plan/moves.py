@@ -62,9 +62,13 @@ class PlannerMoves:
     def axes_d(self) -> np.ndarray:
         return np.asarray(self.end) - np.asarray(self.start)
 
-    def select(self, keep: np.ndarray) -> "PlannerMoves":
-        return PlannerMoves(np.asarray(self.start)[keep], np.asarray(self.end)[keep], self.speed_v[keep],
-                            self.row[keep], self.waypoint[keep])
+    def select(self, keep: np.ndarray | slice) -> "PlannerMoves":
+        """The moves ``keep`` (a slice reads gathered points for those moves alone)."""
+        if isinstance(keep, slice):
+            start, end = self.start[keep], self.end[keep]
+        else:
+            start, end = np.asarray(self.start)[keep], np.asarray(self.end)[keep]
+        return PlannerMoves(start, end, self.speed_v[keep], self.row[keep], self.waypoint[keep])
 
     def planned(self) -> "PlannedMoves":
         """What an operation keeps after planning: no end points, just each move's length."""

@@ -98,6 +98,7 @@ class _Gathered:
     """``MoveEnds.start`` or ``.end``: indexed by a slice of moves, the ``(m, 4)`` array of their points."""
 
     def __init__(self, ends: MoveEnds, which: str):
+        self.ends = ends
         self._of = ends.starts if which == "start" else ends.ends
         self._n = len(ends)
 
