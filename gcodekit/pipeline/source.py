@@ -19,7 +19,7 @@ from ..emulate.machine import Machine
 from ..errors import Diagnostics
 from ..limits import Limits
 from ..parse import CommandTable
-from ..read import Blocks, iter_counted_blocks, iter_lines
+from ..read import COMPILED_AFTER_BYTES, Blocks, iter_counted_blocks, iter_lines, scans_without_gil
 from ..read.ahead import read_ahead
 from ..read.percent import until_closing_percent
 from ..syntax import Flavor
@@ -32,8 +32,9 @@ _O_WORD_LINE = re.compile(r"(?im)^[ \t]*(?:/[ \t]*)?(?:n[0-9. \t]*)?o")
 _SUBPROGRAM_M = re.compile(r"(?i)m\s*0*9\s*[89](?![\s.]*\d)")  # M98/M99: Fanuc-style subprogram flow
 #: Line numbers from here up stand for lines of subroutine files (see number_other_files)
 ELSEWHERE_LINES = 1 << 30
-#: Program files from this size on disk are read on a second thread, ahead of the machine (see read.ahead)
-READ_AHEAD_BYTES = 1 << 20
+#: Program files from this size on disk are read on a second thread, ahead of the machine (see read.ahead),
+#: when the compiled scanner reads them: the NumPy scanner holds the GIL too often to gain from a thread
+READ_AHEAD_BYTES = COMPILED_AFTER_BYTES
 
 
 def program_blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, bar=None,
@@ -98,7 +99,8 @@ def program_blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, b
         return _plain_blocks(chunks(reported_to), flavor, reported_to, bar, size)
 
     # a large file's next chunk is read on another thread while the machine runs this one
-    yield from read_ahead(blocks, diagnostics) if size >= READ_AHEAD_BYTES else blocks(diagnostics)
+    ahead = size >= READ_AHEAD_BYTES and scans_without_gil(flavor)
+    yield from read_ahead(blocks, diagnostics) if ahead else blocks(diagnostics)
 
 
 def _plain_blocks(chunks: Iterator[bytes], flavor: Flavor, diagnostics: Diagnostics, bar=None,

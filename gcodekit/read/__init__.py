@@ -14,6 +14,7 @@ Examples
 
 from __future__ import annotations
 
+import importlib.util
 import os
 from pathlib import Path
 from typing import Iterable, Iterator
@@ -29,7 +30,8 @@ from .source import MAX_LINE_LENGTH, iter_lines, open_program, program_lines
 from .tokenize import LineTokenizer, RawBlock
 
 __all__ = ["Block", "Blocks", "Word", "read_text", "read_file", "iter_blocks", "iter_counted_blocks", "iter_lines",
-           "open_program", "program_lines", "read_source_lines", "iter_source_blocks", "MAX_LINE_LENGTH"]
+           "open_program", "program_lines", "read_source_lines", "iter_source_blocks", "scans_without_gil",
+           "MAX_LINE_LENGTH", "COMPILED_AFTER_BYTES"]
 
 #: Preprocessed lines read into one chunk of blocks (see :func:`iter_source_blocks`)
 CHUNK_LINES = 50_000
@@ -67,6 +69,12 @@ def iter_blocks(
     """
     for blocks, _ in iter_counted_blocks(chunks, flavor, diagnostics, engine=engine, size_hint=size_hint):
         yield blocks
+
+
+def scans_without_gil(flavor: Flavor) -> bool:
+    """Whether the compiled scanner can read ``flavor`` and Numba is installed (looked up, not imported):
+    then scanning a chunk releases the GIL, and reading ahead on a second thread pays."""
+    return fast_path_possible(flavor) and importlib.util.find_spec("numba") is not None
 
 
 def iter_counted_blocks(chunks: Iterable[bytes], flavor: Flavor, diagnostics: Diagnostics, *, engine: str = "auto",
