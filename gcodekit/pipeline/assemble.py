@@ -73,7 +73,7 @@ class WaypointJoiner:
                 continue
             if runs is not None:  # no longer one value: the chunks so far written out, each with its own
                 del self._constant[key]
-                column = self._column(key, col.dtype)
+                column = self._column(key, np.result_type(col.dtype, *(value.dtype for value, _ in runs)))
                 for value, count in runs:
                     column.fill(value, count)
             self._column(key, col.dtype).append(col)
