@@ -7,6 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gcodekit import plan
+from gcodekit.plan.lookahead import lookahead
 from gcodekit.plan.moves import PlannedMoves, PlannerMoves, PlanResult, happens_before
 
 
@@ -62,3 +63,29 @@ def test_waypoint_times_summed_a_block_at_a_time_are_one_bincount(gaps, size, in
     moves = PlannedMoves(np.ones(waypoint.size), waypoint, waypoint, np.ones(waypoint.size))
     expected = np.bincount(waypoint, weights=durations, minlength=n)
     np.testing.assert_array_equal(plan.waypoint_times(w, moves, result).view(np.int64), expected.view(np.int64))
+
+
+v2 = st.one_of(st.floats(0.0, 1e4), st.sampled_from([0.0, 0.0025, 1.0]))  # finite, as planners cap
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(v2, v2, st.booleans(), st.booleans()), min_size=1, max_size=30))
+def test_lookahead_writing_over_its_inputs_gives_the_same_speeds(moves):
+    """``lookahead(reuse=True)`` overwrites the caller's caps and increments: the speeds must not change,
+    and both must be the grbl recurrences, computed here move by move."""
+    cap, delta, rest, nominal = (np.array(c) for c in zip(*moves))
+    rest[-1] = True  # the program ends at rest
+    kept = lookahead(cap.copy(), delta.copy(), rest, rest_v2=0.0025, nominal_length=nominal)
+    reused = lookahead(cap.copy(), delta.copy(), rest, rest_v2=0.0025, nominal_length=nominal, reuse=True)
+    for a, b in zip(kept, reused):
+        np.testing.assert_array_equal(a.view(np.int64), b.view(np.int64))
+    # by hand: reverse from each stop (or nominal_length move) at its cap, then forward
+    n, entry = len(cap), np.empty(len(cap))
+    for i in reversed(range(n)):
+        free = rest[i] or nominal[i]
+        bound = min(cap[i], 0.0025 + delta[i]) if rest[i] and not nominal[i] else cap[i]
+        entry[i] = bound if free or i == n - 1 else min(bound, entry[i + 1] + delta[i])
+    for i in range(1, n):
+        if not (rest[i - 1] or nominal[i - 1]):
+            entry[i] = min(entry[i], entry[i - 1] + delta[i - 1])
+    np.testing.assert_allclose(kept[0], entry, rtol=1e-9, atol=1e-9)  # the scans rebuild sums block-wise

@@ -86,9 +86,15 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     else:
         bound = np.where(stop, np.minimum(max_entry_v2, rest_v2 + delta_v2), max_entry_v2)
     del stop, max_entry_v2
-    reverse_v2 = backward_min(bound, np.where(free, bound, delta_v2))
-    del bound  # each array dropped as soon as it is used: the plan of a large program is memory-bound
-    forward_inc = delta_v2 if reuse and _writable(delta_v2) else delta_v2.copy()
+    reuse_delta = reuse and _writable(delta_v2)
+    if reuse_delta:  # the reverse increments over delta_v2: where they differ, the forward pass's are rewritten
+        increments = delta_v2  # below (cut), but for the last move's, which the forward pass never reads
+        np.copyto(increments, bound, where=free)
+    else:
+        increments = np.where(free, bound, delta_v2)
+    reverse_v2 = backward_min(bound, increments)
+    del bound, increments  # each array dropped as soon as it is used: the plan of a large program is memory-bound
+    forward_inc = delta_v2 if reuse_delta else delta_v2.copy()
     del delta_v2
     cut = np.flatnonzero(free[:-1])
     del free
