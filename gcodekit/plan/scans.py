@@ -16,10 +16,13 @@ m[i-1] - S[i-1])``: a running minimum, ``np.minimum.accumulate``.
 
 ``cap - S`` rounds away the last digits of small caps (a near-reversal
 corner allows 1e-7 mm^2/s^2), so the scan only decides *which* bound holds
-at each move; the values are then rebuilt exactly: a move bound by its cap
-takes the cap itself, a move bound by its predecessor adds the increments
-since the last cap, as the firmware's loop does.  Sums restart every
-:data:`BLOCK` moves so that their size never costs precision.
+at each move; the values are then rebuilt: a move bound by its cap takes
+the cap itself, a move bound by its predecessor the last cap plus the
+increments since, as ``(cap - S[k]) + S[i]``.  That is the firmware's
+loop's value up to the last bits (its increments are added one at a time:
+0.0075 here can be 0.00749999999999984); the compiled loops do the same
+arithmetic as this code.  Sums restart every :data:`BLOCK` moves so that
+their size never costs precision.
 """
 
 from __future__ import annotations
@@ -81,7 +84,7 @@ def _floats(a: np.ndarray) -> np.ndarray:
 
 
 def _rebuild(cap: np.ndarray, s: np.ndarray, binds: np.ndarray, seed: float) -> np.ndarray:
-    """Exact values: ``cap[k]`` where the cap binds, else the last bound value
+    """The values: ``cap[k]`` where the cap binds, else the last bound value
     plus the increments since (``s`` are running sums, ``seed + s`` before any cap)."""
     k = np.where(binds, np.arange(cap.size), -1)
     np.maximum.accumulate(k, out=k)
