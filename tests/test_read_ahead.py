@@ -78,6 +78,14 @@ def test_an_error_of_the_producer_is_raised_on_the_consumer_after_the_items_befo
     assert taken == [1, 2]
 
 
+def test_a_producer_that_fails_before_its_first_item_fails_the_consumer_instead_of_hanging_it():
+    def produce(diagnostics):
+        raise OSError("cannot open the program")
+
+    with pytest.raises(OSError, match="cannot open the program"):
+        next(read_ahead(produce, Diagnostics()))
+
+
 def test_a_consumer_that_stops_early_stops_the_producer_and_closes_its_source():
     closed: list = []
     before = {t.ident for t in threading.enumerate()}

@@ -68,8 +68,9 @@ def read_ahead(produce: Callable[[Diagnostics], Iterator[T]], diagnostics: Diagn
         return False
 
     def work() -> None:
-        items = produce(recorder)  # type: ignore[arg-type]
+        items = None
         try:
+            items = produce(recorder)  # type: ignore[arg-type]
             for item in items:
                 if not put((item, recorder.take())):
                     return
