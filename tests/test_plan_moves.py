@@ -89,3 +89,11 @@ def test_lookahead_writing_over_its_inputs_gives_the_same_speeds(moves):
         if not (rest[i - 1] or nominal[i - 1]):
             entry[i] = min(entry[i], entry[i - 1] + delta[i - 1])
     np.testing.assert_allclose(kept[0], entry, rtol=1e-9, atol=1e-9)  # the scans rebuild sums block-wise
+
+
+def test_the_points_of_no_moves_are_empty_arrays():
+    from gcodekit.plan.points import MoveEnds
+
+    for chained in (True, False):
+        start, end = MoveEnds((np.zeros(3),) * 4, np.zeros(0, np.int32), chained).arrays()
+        assert start.shape == end.shape == (0, 4)

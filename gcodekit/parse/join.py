@@ -15,7 +15,7 @@ import numpy as np
 from ..growing import GrowingColumn
 from .table import CommandTable, SparseColumn
 
-__all__ = ["TableJoiner", "concat_tables"]
+__all__ = ["TableJoiner"]
 
 _COLUMNS = ("line", "kind", "letter", "number", "name", "motion")
 
@@ -122,16 +122,6 @@ class TableJoiner:
         )
         assert len(table) == n
         return table.compact()
-
-
-def concat_tables(parts: list[CommandTable]) -> CommandTable:
-    """Join consecutive chunks' tables (at least one); ``parts`` is emptied as they are taken."""
-    joiner = TableJoiner()
-    while parts:
-        joiner.add(parts.pop(0))
-    table = joiner.finish()
-    assert table is not None, "no tables to join"
-    return table
 
 
 def _joined_offsets(offsets: list[np.ndarray]) -> np.ndarray:

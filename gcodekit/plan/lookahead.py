@@ -87,8 +87,10 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
         bound = np.where(stop, np.minimum(max_entry_v2, rest_v2 + delta_v2), max_entry_v2)
     del stop, max_entry_v2
     reuse_delta = reuse and _writable(delta_v2)
-    if reuse_delta:  # the reverse increments over delta_v2: where they differ, the forward pass's are rewritten
-        increments = delta_v2  # below (cut), but for the last move's, which the forward pass never reads
+    if reuse_delta:
+        # the reverse pass's increments written over delta_v2: each one that differs is rewritten for the
+        # forward pass below (cut), but the last move's, which the forward pass never reads
+        increments = delta_v2
         np.copyto(increments, bound, where=free)
     else:
         increments = np.where(free, bound, delta_v2)

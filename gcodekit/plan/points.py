@@ -76,22 +76,14 @@ class MoveEnds:
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray]:
         """Every move's start and end: views of one array of ``n + 1`` points when chained (half the memory)."""
-        idx = self.idx
-        if self.chained:
-            points = np.empty((idx.size + 1, 4))
-            start, end = points[:-1], points[1:]
-        else:
-            start, end = np.empty((idx.size, 4)), np.empty((idx.size, 4))
-        before = np.maximum(idx - 1, 0)
-        for k, col in enumerate(self.columns):
-            end[:, k] = col[idx]
-            if not self.chained:
-                start[:, k] = col[before]
-            elif idx.size:
-                start[0, k] = col[before[0]]
-        if idx.size and idx[0] == 0:
-            start[0] = 0.0
-        return start, end
+        every = slice(None)
+        if not self.chained:
+            return self.starts(every), self.ends(every)
+        points = np.empty((len(self) + 1, 4))
+        points[1:] = self.ends(every)
+        if len(self):
+            points[:1] = self.starts(slice(0, 1))
+        return points[:-1], points[1:]
 
 
 class _Gathered:
