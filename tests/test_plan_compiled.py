@@ -133,6 +133,28 @@ def test_scans_agree(pairs, first, block):
         scans.BLOCK = old
     assert_bits_equal(ref[0], got[0], "forward_min")
     assert_bits_equal(ref[1], got[1], "backward_min")
+    for engine in ("numpy", "numba"):  # written over the caps, as the planners call them: the same values
+        with kernels.using(engine):
+            scans.BLOCK = block
+            try:
+                forward, backward = cap.copy(), cap.copy()
+                assert scans.forward_min(forward, inc, first, out=forward) is forward
+                assert scans.backward_min(backward, inc, first, out=backward) is backward
+            finally:
+                scans.BLOCK = old
+        assert_bits_equal(ref[0], forward, f"forward_min over its caps ({engine})")
+        assert_bits_equal(ref[1], backward, f"backward_min over its caps ({engine})")
+
+
+def test_scans_check_where_they_write():
+    cap, inc = np.ones(3), np.ones(3)
+    for bad in (np.empty(2), np.empty(3, np.float32), np.empty(6)[::2]):
+        with pytest.raises(ValueError, match="contiguous float64 array of 3"):
+            scans.forward_min(cap, inc, out=bad)
+    frozen = np.empty(3)
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError):
+        scans.backward_min(cap, inc, out=frozen)
 
 
 def test_auto_engine_by_size():
@@ -174,12 +196,16 @@ def test_klipper_cruise_agrees(rows):
     start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2 = (np.array(c, float) for c in list(zip(*rows))[:5])
     flush = np.array([r[5] for r in rows])
     flush[0] = True
-    m = {"delta_v2": delta_v2, "mcr_delta_v2": mcr_delta_v2, "max_cruise_v2": max_cruise_v2}
-    ref = klipper._cruise(start_v2, mcr_start_v2, m, flush)
-    got = kernels.compiled().klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush,
-                                            klipper.TIE)
-    assert_bits_equal(ref[0], got[0], "cruise_v2")
-    assert_bits_equal(ref[1], got[1], "next_start_v2")
+    m = {"delta_v2": delta_v2, "mcr_delta_v2": mcr_delta_v2}
+    ref = klipper._cruise(start_v2, mcr_start_v2, m, max_cruise_v2, flush)
+    into = max_cruise_v2.copy()  # the planner's call: the speeds written over their caps
+    got = kernels.compiled().klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, into, flush,
+                                            klipper.TIE, into)
+    assert got is into
+    assert_bits_equal(ref, got, "cruise_v2")
+    apart = kernels.compiled().klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush,
+                                              klipper.TIE, np.empty(len(rows)))
+    assert_bits_equal(ref, apart, "cruise_v2 into a new array")
 
 
 def test_move_points_agree():

@@ -78,7 +78,7 @@ def test_lookahead_writing_over_its_inputs_gives_the_same_speeds(moves):
     kept = lookahead(cap.copy(), delta.copy(), rest, rest_v2=0.0025, nominal_length=nominal)
     reused = lookahead(cap.copy(), delta.copy(), rest, rest_v2=0.0025, nominal_length=nominal, reuse=True)
     for a, b in zip(kept, reused):
-        np.testing.assert_array_equal(a.view(np.int64), b.view(np.int64))
+        np.testing.assert_array_equal(np.asarray(a).view(np.int64), np.asarray(b).view(np.int64))
     # by hand: reverse from each stop (or nominal_length move) at its cap, then forward
     n, entry = len(cap), np.empty(len(cap))
     for i in reversed(range(n)):
@@ -89,6 +89,40 @@ def test_lookahead_writing_over_its_inputs_gives_the_same_speeds(moves):
         if not (rest[i - 1] or nominal[i - 1]):
             entry[i] = min(entry[i], entry[i - 1] + delta[i - 1])
     np.testing.assert_allclose(kept[0], entry, rtol=1e-9, atol=1e-9)  # the scans rebuild sums block-wise
+    # each move exits at the next one's entry, the very value, but at the rest speed after a stop and the last
+    exit_v2 = [0.0025 if rest[i] or i == n - 1 else kept[0][i + 1] for i in range(n)]
+    np.testing.assert_array_equal(np.asarray(kept[1]).view(np.int64), np.array(exit_v2).view(np.int64))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 12), st.data())
+def test_next_entry_reads_like_the_stored_exits(n, data):
+    """:class:`NextEntry` indexed any way gives what the stored exits did (the old rule, written here)."""
+    from gcodekit.plan.trapezoids import NextEntry
+
+    entry = np.arange(n, dtype=float) + 0.5
+    entry[::3] = -0.0  # signed zeros copied as they are
+    rest = np.array(data.draw(st.lists(st.booleans(), min_size=n, max_size=n)), bool)
+    stored = np.empty(n)
+    stored[:-1] = entry[1:]
+    stored[-1:] = 0.0025
+    stored[rest] = 0.0025
+    exits = NextEntry(entry, np.flatnonzero(rest), 0.0025)
+    assert len(exits) == n and exits.shape == (n,)
+
+    def same(got, expected):
+        np.testing.assert_array_equal(np.asarray(got).view(np.int64), np.asarray(expected).view(np.int64))
+
+    same(np.asarray(exits), stored)
+    lo, hi = data.draw(st.integers(-n - 2, n + 2)), data.draw(st.integers(-n - 2, n + 2))
+    step = data.draw(st.sampled_from([None, 1, 2, -1]))
+    same(exits[lo:hi:step], stored[lo:hi:step])
+    if n:
+        picked = np.array(data.draw(st.lists(st.integers(-n, n - 1), max_size=8)), np.int64)
+        same(exits[picked], stored[picked])
+        same(exits[rest], stored[rest])
+        k = data.draw(st.integers(-n, n - 1))
+        same(exits[k], stored[k])
 
 
 def test_the_points_of_no_moves_are_empty_arrays():

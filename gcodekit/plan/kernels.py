@@ -80,10 +80,10 @@ def using(name: str) -> Iterator[None]:
         _chosen.reset(token)
 
 
-def _forward_min(cap, inc, first, block):
-    """:func:`.scans.forward_min` (see it for the rule), block by block with its very roundings."""
+def _forward_min(cap, inc, first, block, out):
+    """:func:`.scans.forward_min` (see it for the rule), block by block with its very roundings, into
+    ``out`` (which may be ``cap``: ``cap[k]`` is last read before ``out[k]`` is written)."""
     n = cap.size
-    out = np.empty(n)
     carry = first
     for start in range(0, n, block):
         stop = min(start + block, n)
@@ -118,10 +118,10 @@ def _forward_min(cap, inc, first, block):
     return out
 
 
-def _backward_min(cap, inc, last, block):
-    """:func:`.scans.backward_min` (see it for the rule), block by block with its very roundings."""
+def _backward_min(cap, inc, last, block, out):
+    """:func:`.scans.backward_min` (see it for the rule), block by block with its very roundings, into
+    ``out`` (which may be ``cap``, as in :func:`_forward_min`)."""
     n = cap.size
-    out = np.empty(n)
     carry = last
     for stop in range(n, 0, -block):
         start = max(stop - block, 0)
@@ -350,8 +350,9 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, idx, chained, speed_v, 
     return move_d_out, accel_out, max_cruise_v2_out, delta_v2_out, mcr_delta_v2_out, cap_out, junction
 
 
-def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush, tie_r):
-    """:func:`.klipper._cruise`: each move's cruise speed squared and the next move's start.
+def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush, tie_r, cruise_v2):
+    """:func:`.klipper._cruise`: each move's cruise speed squared, into ``cruise_v2`` (which may be
+    ``max_cruise_v2``: each cap is read before its move's speed is written).
 
     A backward pass finds, for each move, the nearest move at or after it in
     the same flush that sets a peak (``next_marked``); a forward pass keeps
@@ -359,8 +360,6 @@ def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v
     whose minimum is the earliest of equal values, as here).
     """
     n = start_v2.size
-    cruise_v2 = np.empty(n)
-    next_start_v2 = np.empty(n)
     can_accel = np.empty(n, np.bool_)
     has_next = False  # a peak-setting move at or after i in i's flush
     peak = 0.0
@@ -371,7 +370,6 @@ def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v
             has_next = False  # the next flush's peaks are not this one's
         else:
             next_start, next_mcr = start_v2[i + 1], mcr_start_v2[i + 1]
-        next_start_v2[i] = next_start
         reach = next_mcr + mcr_delta_v2[i]
         tie = tie_r * (reach if (reach > 1.0 or reach != reach) else 1.0)
         accel = mcr_start_v2[i] < reach - tie
@@ -401,7 +399,7 @@ def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v
         elif seed < acc or seed != seed:  # np.minimum(seed, acc): the earlier on a tie
             acc = seed
         cruise_v2[i] = acc
-    return cruise_v2, next_start_v2
+    return cruise_v2
 
 
 def _move_points(x, y, z, de, motion, homing, distance, with_points):

@@ -27,7 +27,7 @@ from ..memory import release_freed_memory
 from .kernels import engine
 from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
-from .trapezoids import TrapezoidPlan
+from .trapezoids import NextEntry, TrapezoidPlan
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -232,19 +232,25 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
     release_freed_memory()
 
     # max_start_v2 = min(cap, prev.max_start_v2 + prev.delta_v2): forward scans
-    max_start_v2 = forward_min(m.pop("cap"), m["delta_v2"])
-    max_mcr_start_v2 = forward_min(np.where(junction, max_start_v2, 0.0), m["mcr_delta_v2"])
+    # (each scan writes over the array it scans, which nothing reads after it: two arrays fewer at the peak)
+    cap = m.pop("cap")
+    max_start_v2 = forward_min(cap, m["delta_v2"], out=cap)
+    mcr_cap = np.where(junction, max_start_v2, 0.0)
+    max_mcr_start_v2 = forward_min(mcr_cap, m["mcr_delta_v2"], out=mcr_cap)
     # LookAheadQueue.flush, backward: assume a stop after the last move of each flush
-    start_v2 = backward_min(max_start_v2, m["delta_v2"])
-    mcr_start_v2 = backward_min(max_mcr_start_v2, m["mcr_delta_v2"])
-    del max_start_v2, max_mcr_start_v2
+    start_v2 = backward_min(max_start_v2, m["delta_v2"], out=max_start_v2)
+    mcr_start_v2 = backward_min(max_mcr_start_v2, m["mcr_delta_v2"], out=max_mcr_start_v2)
+    del cap, mcr_cap, max_start_v2, max_mcr_start_v2
+    max_cruise_v2 = m.pop("max_cruise_v2")  # the cruise speeds are written over their caps
     if compiled is not None:
-        cruise_v2, next_start_v2 = compiled.klipper_cruise(start_v2, mcr_start_v2, m["delta_v2"], m["mcr_delta_v2"],
-                                                           m["max_cruise_v2"], flush, TIE)
+        cruise_v2 = compiled.klipper_cruise(start_v2, mcr_start_v2, m["delta_v2"], m["mcr_delta_v2"], max_cruise_v2,
+                                            flush, TIE, max_cruise_v2)
     else:
-        cruise_v2, next_start_v2 = _cruise(start_v2, mcr_start_v2, m, flush)
-    del mcr_start_v2, m["max_cruise_v2"], m["delta_v2"], m["mcr_delta_v2"]  # free before the trapezoids
+        cruise_v2 = _cruise(start_v2, mcr_start_v2, m, max_cruise_v2, flush)
+    del mcr_start_v2, max_cruise_v2, m["delta_v2"], m["mcr_delta_v2"]  # free before the trapezoids
     release_freed_memory()
+    # a move ends at the next one's start, but at rest before a flush and after the last move (not stored)
+    next_start_v2 = NextEntry(start_v2, np.flatnonzero(flush[1:]), 0.0)
     return planned, _set_junction(start_v2, cruise_v2, next_start_v2, m)
 
 
@@ -358,8 +364,8 @@ def _move_block(moves, rows, limits, config, flush, lo, hi, m, junction) -> None
         m["cap"][lo + 1:hi] = np.where(junction[lo + 1:hi], cap, 0.0)
 
 
-def _cruise(start_v2, mcr_start_v2, m, flush):
-    """LookAheadQueue.flush: each move's cruise speed, and the next move's start."""
+def _cruise(start_v2, mcr_start_v2, m, max_cruise_v2, flush):
+    """LookAheadQueue.flush: each move's cruise speed (at most ``max_cruise_v2``)."""
     n = start_v2.size
     segment = np.cumsum(flush, dtype=np.int32)
     last_of_segment = np.r_[segment[1:] != segment[:-1], True]
@@ -388,13 +394,13 @@ def _cruise(start_v2, mcr_start_v2, m, flush):
     cruise_v2 = next_start_v2 + m["delta_v2"]  # reachable_start_v2
     cruise_v2 += start_v2
     cruise_v2 *= 0.5
-    np.minimum(cruise_v2, m["max_cruise_v2"], out=cruise_v2)
+    np.minimum(cruise_v2, max_cruise_v2, out=cruise_v2)
     np.minimum(cruise_v2, peak_cruise_v2, out=cruise_v2)
     del peak_cruise_v2
     # forward: a move that cannot accelerate keeps min(previous cruise, its start)
     chain = np.cumsum(can_accel | flush, dtype=np.int32)
     seed = np.where(can_accel, cruise_v2, np.where(flush, 0.0, start_v2))
-    return segmented_cummin(seed, chain), next_start_v2
+    return segmented_cummin(seed, chain)
 
 
 def _set_junction(start_v2, cruise_v2, next_start_v2, m) -> TrapezoidPlan:

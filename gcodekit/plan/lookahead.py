@@ -12,7 +12,7 @@ import numpy as np
 
 from .moves import PlanResult
 from .scans import backward_min, forward_min
-from .trapezoids import TrapezoidPlan
+from .trapezoids import NextEntry, TrapezoidPlan
 
 __all__ = ["BLOCK", "limit_by_axis_maximum", "lookahead", "trapezoid", "empty_result", "unit_vectors"]
 
@@ -60,7 +60,9 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
 
     Returns
     -------
-    entry_v2, exit_v2 : ndarray
+    entry_v2 : ndarray
+    exit_v2 : NextEntry
+        The next move's entry, ``rest_v2`` after a stop (not stored).
 
     Notes
     -----
@@ -94,20 +96,18 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
         np.copyto(increments, bound, where=free)
     else:
         increments = np.where(free, bound, delta_v2)
-    reverse_v2 = backward_min(bound, increments)
-    del bound, increments  # each array dropped as soon as it is used: the plan of a large program is memory-bound
+    # each pass writes over its bounds (ours, or max_entry_v2 given to reuse), and each array is dropped as
+    # soon as it is used: the plan of a large program is memory-bound
+    reverse_v2 = backward_min(bound, increments, out=bound)
+    del bound, increments
     forward_inc = delta_v2 if reuse_delta else delta_v2.copy()
     del delta_v2
     cut = np.flatnonzero(free[:-1])
     del free
     forward_inc[cut] = reverse_v2[cut + 1]
-    entry_v2 = forward_min(reverse_v2, forward_inc, first=float(reverse_v2[0])) if n else reverse_v2
+    entry_v2 = forward_min(reverse_v2, forward_inc, first=float(reverse_v2[0]), out=reverse_v2) if n else reverse_v2
     del forward_inc, reverse_v2
-    exit_v2 = np.empty(n)
-    exit_v2[:-1] = entry_v2[1:]
-    exit_v2[-1:] = rest_v2
-    exit_v2[rest_after] = rest_v2
-    return entry_v2, exit_v2
+    return entry_v2, NextEntry(entry_v2, np.flatnonzero(rest_after), rest_v2)
 
 
 def _writable(a) -> bool:

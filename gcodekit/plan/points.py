@@ -42,8 +42,17 @@ class MoveEnds:
         self.columns = columns
         self.idx = idx
         self.chained = is_chained
-        self.start = _Gathered(self, "start")
-        self.end = _Gathered(self, "end")
+
+    @property
+    def start(self) -> "_Gathered":
+        """The moves' start points, gathered when indexed (made on each read: no reference cycle, so the
+        columns are freed as soon as the last view of them is)."""
+        return _Gathered(self, "start")
+
+    @property
+    def end(self) -> "_Gathered":
+        """The moves' end points, gathered when indexed."""
+        return _Gathered(self, "end")
 
     def __len__(self) -> int:
         return int(self.idx.size)

@@ -34,13 +34,18 @@ from .kernels import engine
 BLOCK = 4096
 
 
-def forward_min(cap: np.ndarray, inc: np.ndarray, first: float = 0.0) -> np.ndarray:
-    """``m[0] = min(cap[0], first)``; ``m[i] = min(cap[i], m[i-1] + inc[i-1])``."""
+def forward_min(cap: np.ndarray, inc: np.ndarray, first: float = 0.0, *, out: np.ndarray | None = None) -> np.ndarray:
+    """``m[0] = min(cap[0], first)``; ``m[i] = min(cap[i], m[i-1] + inc[i-1])``.
+
+    ``out`` (a float64 array of ``cap``'s size, which may be ``cap`` itself:
+    each cap is read before its move's value is written) receives ``m``.
+    """
+    out = _output(out, cap)
     kernels = engine(cap.size)
     if kernels is not None:
-        return kernels.forward_min(_floats(cap), _floats(inc), float(first), BLOCK)
+        kernels.forward_min(_floats(cap), _floats(inc), float(first), BLOCK, out)
+        return out
     n = cap.size
-    out = np.empty(n)
     carry = first  # what the move before the block allows at the block's first junction
     for start in range(0, n, BLOCK):
         stop = min(start + BLOCK, n)
@@ -56,13 +61,17 @@ def forward_min(cap: np.ndarray, inc: np.ndarray, first: float = 0.0) -> np.ndar
     return out
 
 
-def backward_min(cap: np.ndarray, inc: np.ndarray, last: float = 0.0) -> np.ndarray:
-    """``s[n-1] = min(cap[n-1], last + inc[n-1])``; ``s[i] = min(cap[i], s[i+1] + inc[i])``."""
+def backward_min(cap: np.ndarray, inc: np.ndarray, last: float = 0.0, *, out: np.ndarray | None = None) -> np.ndarray:
+    """``s[n-1] = min(cap[n-1], last + inc[n-1])``; ``s[i] = min(cap[i], s[i+1] + inc[i])``.
+
+    ``out`` as in :func:`forward_min` (``cap`` itself allowed).
+    """
+    out = _output(out, cap)
     kernels = engine(cap.size)
     if kernels is not None:
-        return kernels.backward_min(_floats(cap), _floats(inc), float(last), BLOCK)
+        kernels.backward_min(_floats(cap), _floats(inc), float(last), BLOCK, out)
+        return out
     n = cap.size
-    out = np.empty(n)
     carry = last  # s of the move after the block
     for stop in range(n, 0, -BLOCK):
         start = max(stop - BLOCK, 0)
@@ -76,6 +85,15 @@ def backward_min(cap: np.ndarray, inc: np.ndarray, last: float = 0.0) -> np.ndar
         r = _rebuild(c, s, c <= reach, carry + d[0] - s[0])
         out[start:stop] = r[::-1]
         carry = out[start]
+    return out
+
+
+def _output(out: np.ndarray | None, cap: np.ndarray) -> np.ndarray:
+    """Where a scan writes: ``out`` when given (checked), else a new array."""
+    if out is None:
+        return np.empty(cap.size)
+    if out.dtype != np.float64 or out.shape != (cap.size,) or not out.flags.c_contiguous or not out.flags.writeable:
+        raise ValueError(f"a scan writes into a writable contiguous float64 array of {cap.size} values")
     return out
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from .kernels import engine
 from .moves import PlanResult
 
-__all__ = ["TrapezoidPlan", "FIELDS"]
+__all__ = ["TrapezoidPlan", "NextEntry", "FIELDS"]
 
 #: The fields computed on reading (``accel`` is kept).
 FIELDS = ("start_v", "cruise_v", "end_v", "accel_t", "cruise_t", "decel_t")
@@ -49,6 +49,61 @@ def _computed(field: str) -> property:
     return property(read)
 
 
+class NextEntry:
+    """Each move's exit speed squared, kept as the entries it repeats: the next move's entry, or ``rest_v2``
+    where the machine stops after the move (and after the last one).
+
+    A lookahead planner ends each move at the speed the next one enters at,
+    so a plan need not store the exits: indexed (by a slice, indices or a
+    mask), this gives them, bit for bit the entries they copy.
+
+    Parameters
+    ----------
+    entry_v2 : ndarray
+        Each move's entry speed squared.
+    stops : ndarray of int
+        The moves after which the machine stops, sorted.
+    rest_v2 : float
+        The speed squared at a stop.
+    """
+
+    def __init__(self, entry_v2: np.ndarray, stops: np.ndarray, rest_v2: float):
+        self.entry_v2, self.stops, self.rest_v2 = entry_v2, stops, float(rest_v2)
+
+    def __len__(self) -> int:
+        return int(self.entry_v2.size)
+
+    @property
+    def shape(self) -> tuple[int]:
+        return (len(self),)
+
+    def __getitem__(self, sel) -> np.ndarray:
+        n = len(self)
+        if isinstance(sel, slice) and sel.indices(n)[2] == 1:
+            lo, hi, _ = sel.indices(n)
+            hi = max(hi, lo)
+            out = np.empty(hi - lo)
+            inner = min(hi, n - 1)  # the moves whose next move exists
+            out[:max(inner - lo, 0)] = self.entry_v2[lo + 1:inner + 1]
+            out[max(inner - lo, 0):] = self.rest_v2  # the last move
+            stops = self.stops[np.searchsorted(self.stops, lo):np.searchsorted(self.stops, hi)]
+            out[stops - lo] = self.rest_v2
+            return out
+        moves = np.arange(n)[sel]
+        if moves.ndim == 0:  # one move: a number
+            return self[int(moves):int(moves) + 1][0]
+        following = moves + 1
+        out = self.entry_v2[np.minimum(following, n - 1)]
+        at = np.minimum(np.searchsorted(self.stops, moves), max(self.stops.size - 1, 0))
+        stopped = (following >= n) | ((self.stops[at] == moves) if self.stops.size else False)
+        out[stopped] = self.rest_v2
+        return out
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        out = self[:]
+        return out if dtype is None else out.astype(dtype)
+
+
 class TrapezoidPlan:
     """:class:`.moves.PlanResult`'s arrays, computed from the squared speeds when read.
 
@@ -58,8 +113,9 @@ class TrapezoidPlan:
         The planner's block function (see :data:`Shape`).
     move_d, accel : ndarray
         Each move's length (mm) and acceleration (mm/s^2).
-    *v2 : ndarray
-        The three squared speeds ``shape`` takes, mm^2/s^2.
+    *v2 : ndarray or NextEntry
+        The three squared speeds ``shape`` takes, mm^2/s^2 (the exits may be
+        a :class:`NextEntry`).
     kernel : str, default: None
         The name of ``shape``'s compiled loop in :mod:`.kernels`, used when
         :func:`.kernels.engine` chooses it for a plan this size.
