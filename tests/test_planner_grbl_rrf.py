@@ -9,6 +9,7 @@ count) and checks the planner against it; a per-move oracle of grbl's
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -47,6 +48,26 @@ def trapezoid_time(d, v, a, v0=0.0, v1=0.0):
 def test_grbl_single_move():
     moves, result = grbl_plan("G1 X100 F1200\n")  # 20 mm/s, 100 mm/s^2: 2 mm ramps
     assert result.duration_t[0] == pytest.approx(0.2 + 96.0 / 20.0 + 0.2)
+
+
+def test_grbl_drops_extruder_only_moves_as_blocks_without_steps():
+    """GRBL has no extruder: ``plan_buffer_line`` drops a block without steps, so a 3D printer's retract
+    neither takes time nor breaks the straight line through it (before, its infinite acceleration times
+    zero length made every speed of the program NaN and its time 0)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no NumPy RuntimeWarning either
+        moves, result = grbl_plan("G1 X10 F1200\nG1 E5\nG1 X100 E6\n")
+    assert len(moves) == 2 and not np.isnan(result.start_v).any()
+    # one straight 100 mm move at 20 mm/s and 100 mm/s^2, cut in two: 2 mm ramps
+    assert float(result.duration_t.sum()) == pytest.approx(0.2 + 96.0 / 20.0 + 0.2)
+    assert result.end_v[0] == pytest.approx(20.0)
+    op = gcodekit.gcode_to_operation("G21 G90\nG1 X10 F1200\nG1 E5\nG1 X100 E6\n", "grbl")
+    line = op.table.line[op.waypoints["command"]]
+    assert op.waypoints["time"][line == 3].tolist() == [0.0] and np.isfinite(op.waypoints["time"]).all()
+    assert float(op.waypoints["time"].sum()) == pytest.approx(5.2)
+    said = [d for d in op.diagnostics if "extruder-only" in d.message]
+    assert [(d.line, d.severity, d.message) for d in said] == [
+        (3, "info", "GRBL moves X, Y and Z only: the 1 extruder-only move takes no time")]
 
 
 def test_grbl_rapid_runs_at_the_max_rate():

@@ -174,6 +174,7 @@ def plan(op: "EmulatedProgram", config: GrblConfig) -> tuple[PlannerMoves, PlanR
     """
     moves = firmware_moves(op, None, lambda travel, angle, radius, speed_v: arc_segments(travel, angle, radius,
                                                                                  config.arc_tolerance))
+    moves = _with_steps(op, moves)
     w = op.waypoints
     # arcs too long to cut into chords within max_motions keep the emulator's time, at rest around them
     has_move = np.zeros(w["x"].size, bool)
@@ -185,6 +186,25 @@ def plan(op: "EmulatedProgram", config: GrblConfig) -> tuple[PlannerMoves, PlanR
     rest_before = follows_kept_step(moves, unplanned) | follows_kept_step(moves, dwells)
     moves, result = _plan_moves(op, moves, config, rest_before)
     return with_kept_steps(w, moves, result, unplanned) if unplanned.size else (moves, result)
+
+
+def _with_steps(op: "EmulatedProgram", moves: PlannerMoves) -> PlannerMoves:
+    """The moves that step X, Y or Z: GRBL has no extruder, and its ``plan_buffer_line`` drops a block
+    without steps (``PLAN_EMPTY_BLOCK``), so an extruder-only move takes no time and is no junction.
+
+    Said once, at the first such move's line, when a program has any (a 3D printer's program planned as
+    a GRBL machine's).
+    """
+    travel = np.asarray(moves.axes_d)[:, :3]
+    stepping = (travel != 0).any(axis=1)
+    if stepping.all():
+        return moves
+    dropped = np.flatnonzero(~stepping)
+    op.diagnostics.report(int(op.table.line[moves.row[dropped[0]]]), 1,
+                          f"GRBL moves X, Y and Z only: the {dropped.size:,} extruder-only "
+                          + ("move takes" if dropped.size == 1 else "moves take") + " no time",
+                          severity="info")
+    return moves.select(np.flatnonzero(stepping))
 
 
 def _plan_moves(op: "EmulatedProgram", moves: PlannerMoves, config: GrblConfig,
