@@ -161,3 +161,19 @@ def test_any_blank_inside_a_number_is_skipped(flavor):
     blocks = read_text("G1 X1 6\r7 Y2\f3 Z\v4\n", flavor=flavor)
     assert [(w.letter, w.value) for w in blocks[0].words] == [("G", 1.0), ("X", 167.0), ("Y", 23.0), ("Z", 4.0)]
     assert not blocks.diagnostics.items
+
+
+@pytest.mark.parametrize("flavor", ["marlin", "klipper", "reprapfirmware"])
+def test_an_f_without_a_number_leaves_the_feed_rate(flavor):
+    """Printer firmware reads a missing number as 0 and sets the feed only from an F above 0 (Marlin's
+    ``parser.floatval('F') > 0``): ``G1 F X20`` moves at the feed in force.  Before, the F was a flag
+    worth 0, so the feed fell to 0, and a CAM program's ``( FrameBottom )`` (its F) on a Klipper machine
+    planned an infinite time."""
+    import gcodekit
+
+    op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F X20\n( FrameBottom )\nG0 Z3\n", flavor, plan=False)
+    assert op.waypoints["feed"].tolist() == [800.0] * len(op.waypoints["feed"])
+    said = [(d.line, d.column, d.severity) for d in op.diagnostics if d.message.startswith("word 'F'")]
+    assert said == [(2, 4, "warning"), (3, 3, "warning")]
+    assert np.isfinite(gcodekit.gcode_to_operation("G1 F800 X10\n( FrameBottom )\nG0 Z3\n", flavor)
+                       .waypoints["time"]).all()

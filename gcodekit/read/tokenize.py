@@ -211,6 +211,10 @@ class LineTokenizer:
                 block.add_text(text[i:end])
                 return end
         if digits == 0:
+            if fl.block_split == "single" and letter == "F":  # no flag: firmware reads a missing number as 0
+                # and keeps its feed rate (Marlin sets it only from an F above 0)
+                self.diagnostics.warn(block.line, col, "word 'F' has no number: the feed rate stays as it was", text)
+                return max(j, i + 1)
             if fl.block_split == "single" and letter not in "GM" and (j >= n or not text[j].isdigit()):
                 block.flags.append((letter, col))
                 return max(j, i + 1)
