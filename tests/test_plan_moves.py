@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import gcodekit
 from gcodekit import plan
 from gcodekit.plan.lookahead import lookahead
 from gcodekit.plan.moves import PlannedMoves, PlannerMoves, PlanResult, happens_before
@@ -131,3 +133,15 @@ def test_the_points_of_no_moves_are_empty_arrays():
     for chained in (True, False):
         start, end = MoveEnds((np.zeros(3),) * 4, np.zeros(0, np.int32), chained).arrays()
         assert start.shape == end.shape == (0, 4)
+
+
+def test_a_move_planned_at_no_speed_has_an_unknown_time():
+    """Klipper moves a G0 at the modal F: after ``G1 F0`` it has no speed, its time is infinite.  The
+    waypoint's time is unknown (NaN, as the emulator has it), not infinity, and no "runs for years"
+    warning follows (its number was 1.8e308 s, written out in 300 digits)."""
+    op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F0\nG0 Z3\n", "klipper")
+    assert np.isinf(op.plan[1].duration_t[1])
+    t = op.waypoints["time"]
+    v, accel = 800 / 60, 3000.0  # Klipper's default max_accel: 10 mm from rest to rest, cruising at v
+    assert np.isnan(t[2]) and t[0] == pytest.approx(10 / v + v / accel, rel=1e-12)
+    assert not any("years" in d.message for d in op.diagnostics)
