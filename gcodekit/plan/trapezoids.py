@@ -6,7 +6,9 @@ length and its acceleration.  :class:`TrapezoidPlan` keeps those inputs
 and computes the speeds and phase times (:class:`.moves.PlanResult`'s
 fields) a block at a time when they are read, with the planner's own block
 function, so they come out the same to the last bit: a planned program
-keeps four arrays per move instead of seven.  Read several fields at once
+keeps three arrays per move besides its lengths (the acceleration, the
+entry and the cruise speed: the exit is the next entry, :class:`NextEntry`)
+instead of seven.  Read several fields at once
 with :meth:`TrapezoidPlan.phases` (each field read alone computes the
 trapezoids again).
 """
