@@ -608,3 +608,22 @@ def test_the_no_tool_table_warning_names_linuxcnc_only_on_linuxcnc(machine, name
     op = gcodekit.gcode_to_operation("T1 M6\nG43 H1\nG1 X1 F100\nM30\n", machine, plan=False)
     (warning,) = [d for d in op.diagnostics.items if "no tool table" in d.message]
     assert ("LinuxCNC" in warning.message) == names_linuxcnc
+
+
+@pytest.mark.parametrize("flavor", ["marlin", "klipper", "prusa_mk3s"])
+def test_f_at_or_below_zero_leaves_a_printer_firmware_s_feed(flavor):
+    """Marlin's gcode.cpp sets the feed only when ``parser.floatval('F') > 0`` (Prusa's firmware likewise;
+    Klipper refuses the command): a move after ``G1 F0`` or ``F-5`` runs at the feed before, on moves and on
+    the blocks the modal handler runs (G92, G28).  Said once, at the first such F."""
+    text = "G1 F800 X10\nG1 F0\nG0 Z3\nG92 E0 F0\nG28 X F-5\nG1 X20 F-5\nG1 X30\n"
+    op = gcodekit.gcode_to_operation(text, flavor, plan=False)
+    assert op.waypoints["feed"].tolist() == [800.0] * len(op.waypoints["feed"])
+    assert np.isfinite(op.waypoints["time"]).all()
+    said = [d for d in op.diagnostics if d.message.startswith("F at or below 0")]
+    assert [(d.line, d.severity) for d in said] == [(2, "warning")]
+
+
+@pytest.mark.parametrize("flavor", ["reprapfirmware", "linuxcnc", "grbl"])
+def test_f0_sets_a_zero_feed_elsewhere(flavor):
+    op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F0\nG1 X20\n", flavor, plan=False)
+    assert op.waypoints["feed"].tolist()[-1] == 0.0 and np.isnan(op.waypoints["time"][-1])

@@ -29,6 +29,7 @@ from ..schema import allocate
 from ..units import MM_PER_INCH, mm_per
 from . import arcs
 from .handlers import Context
+from .handlers.modes import FEED_AT_OR_BELOW_ZERO
 from .fill import forward_fill
 from .ini import LinuxCncIni
 from .modal import ModalHandler, Waypoint
@@ -80,7 +81,8 @@ class Machine:
 
     def __init__(self, config: MachineConfig, diagnostics: Diagnostics | None = None, *,
                  rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = "",
-                 rs274_blocks: bool = False, polar_incremental_only: bool = False, max_motions: int = MAX_MOTIONS):
+                 rs274_blocks: bool = False, polar_incremental_only: bool = False, max_motions: int = MAX_MOTIONS,
+                 feed_above_zero_only: bool = False):
         self.config = config
         self.budget = MotionBudget(max_motions)
         self.out_of_budget = False  # stopped at max_motions: the rest of the program is not run
@@ -90,6 +92,7 @@ class Machine:
         # does, and a word for an axis the machine lacks is an error.  Printer
         # firmware reads F only on moves and U/V/W as flags (Prusa's G28 W).
         self.rs274_blocks = rs274_blocks
+        self.feed_above_zero_only = feed_above_zero_only  # F0 leaves the feed (Marlin)
         self.polar_incremental_only = polar_incremental_only  # GER's G16 rules
         self.state = MachineState()
         self.state.units = mm_per(initial_units)
@@ -120,6 +123,7 @@ class Machine:
         self.modal = ModalHandler(Context(self.state, config, self.diagnostics, self.tools, self.budget,
                                           self.warn_once, rs274_blocks=rs274_blocks,
                                           polar_incremental_only=polar_incremental_only,
+                                          feed_above_zero_only=feed_above_zero_only,
                                           rapid_is_feed=self.rapid_is_feed, comp_profile_ends=self.comp_profile_ends))
 
     # -- running ----------------------------------------------------------------
@@ -340,6 +344,8 @@ class Machine:
         feed_words[kind == Kind.COMMENT] = np.nan
         if not self.rs274_blocks:
             feed_words[kind == Kind.M] = np.nan
+        if self.feed_above_zero_only:
+            self._ignore_feed_at_or_below_zero(t, rows, feed_words)
         if s.feed_mode == "inverse_time":
             feed = feed_words  # 1/min, for this block only
         else:
@@ -557,6 +563,13 @@ class Machine:
         if dwell.any():
             time[dwell] = self._dwell_times(t, rows, dwell)
         return time
+
+    def _ignore_feed_at_or_below_zero(self, t, rows, feed_words) -> None:
+        """Firmware that sets its feed only from an F above 0: such F words go (said once)."""
+        ignored = np.flatnonzero(feed_words <= 0)
+        if ignored.size:
+            self.warn_once("feed at or below 0", int(t.line[rows][int(ignored[0])]), FEED_AT_OR_BELOW_ZERO)
+            feed_words[ignored] = np.nan
 
     def _note_boot_feed(self, t, rows, feed_words, motion, delta) -> None:
         """Once: an info where a move runs at the firmware's boot feed, before any F word."""

@@ -18,7 +18,7 @@ from ..parse.table import (MOTION_CCW, MOTION_CW, MOTION_CYCLE, MOTION_LINEAR, M
                            MOTION_THREAD, NAME_ID, SPLINE_MOTIONS, CommandTable)
 from .arcs import PLANES, single_turn_lengths
 from .handlers import HANDLERS
-from .handlers.modes import UNITS
+from .handlers.modes import FEED_AT_OR_BELOW_ZERO, UNITS
 from .handlers.registry import (AFTER_LATHE_CYCLE, CANNED_CYCLE, LATHE_CYCLE, POLAR_MODE, POLAR_WORDS, SPLINE_MODE,
                                 SYNCHRONIZED, T_WORD, Block, Context, Outcome, Waypoint)
 from .lathe import LATHE_CYCLES
@@ -107,9 +107,13 @@ class ModalHandler:
         return passed
 
     def _read_feed(self, block: Block) -> None:
-        """An F word sets the feed (in RS274NGC whatever else the block does; on firmware not beside an M code)."""
+        """An F word sets the feed (in RS274NGC whatever else the block does; on firmware not beside an M code,
+        and on Marlin only above 0)."""
         ctx, params = self.context, block.params
         if "F" in params and (block.letter != "M" or ctx.rs274_blocks):
+            if ctx.feed_above_zero_only and not params["F"] > 0:
+                ctx.warn_once("feed at or below 0", block.line, FEED_AT_OR_BELOW_ZERO)
+                return
             # an F beside G20/G21 is in the block's new units ("G20 F60" is 60 in/min); where
             # the units change keeps the F number, the units handler converts the feed instead
             keep = ctx.config.units_keep_feed

@@ -200,6 +200,10 @@ class Flavor:
         E mode at program start; ``""`` when the dialect does not extrude.
     rapid_is_feed : bool
         G0 moves at the programmed feed (Marlin), not at the rapid rate.
+    feed_above_zero_only : bool
+        An F word at or below 0 leaves the feed rate as it was: Marlin and
+        Prusa's firmware set it only from an F above 0, Klipper refuses the
+        command ("Invalid speed").
     initial_motion : {"", "rapid", "linear"}
         Motion mode in force at program start (GER starts in G0), so axis
         words alone move; ``""`` when they need a motion code first.
@@ -242,6 +246,7 @@ class Flavor:
     units: str = "mm"
     extrusion: str = ""
     rapid_is_feed: bool = False
+    feed_above_zero_only: bool = False
     initial_motion: str = ""
     layer_comments: tuple[str, ...] = ()
     feature_comment: str = ""
