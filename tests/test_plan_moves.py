@@ -136,10 +136,11 @@ def test_the_points_of_no_moves_are_empty_arrays():
 
 
 def test_a_move_planned_at_no_speed_has_an_unknown_time():
-    """Klipper moves a G0 at the modal F: after ``G1 F0`` it has no speed, its time is infinite.  The
-    waypoint's time is unknown (NaN, as the emulator has it), not infinity, and no "runs for years"
+    """Klipper's planner moves a G0 at the modal F: read as RepRapFirmware writes it (which takes F0 as
+    written; Klipper's own flavor keeps the feed), after ``G1 F0`` it has no speed, its time is infinite.
+    The waypoint's time is unknown (NaN, as the emulator has it), not infinity, and no "runs for years"
     warning follows (its number was 1.8e308 s, written out in 300 digits)."""
-    op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F0\nG0 Z3\n", "klipper")
+    op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F0\nG0 Z3\n", "klipper", flavor="reprapfirmware")
     assert np.isinf(op.plan[1].duration_t[1])
     t = op.waypoints["time"]
     v, accel = 800 / 60, 3000.0  # Klipper's default max_accel: 10 mm from rest to rest, cruising at v
