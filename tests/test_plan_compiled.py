@@ -251,23 +251,44 @@ def test_gathered_move_points_are_the_stored_ones(text, name):
 @pytest.mark.parametrize("text", [
     "G1 X1 Y2 E0.5 F600\nG1 X3 E1\nG1 E1.5\nG1 X-0 Y-0\nG1 Z0.3\nG1 X2 Y2 Z0.6 E2\n",
     "G28\nG1 X0 Y0 F600\nG1 X10 E1\nG1 X10\nG1 E2\nG92 X0\nG1 X5 E3\nG28 X\nG1 X3 Y3\nG1 Z0.3\n",
+    # relative E from a signed zero on: the running sum starts at -0.0, as np.cumsum's does
+    "M83\nG1 X1 E-0 F600\nG1 X2 E0.1\nG1 E-0.3\nG1 X3 E0.1234567\nG92 E0\nG1 X4 E1e-9\nG1 X5 E0.2\n",
 ])
 def test_klippers_compiled_set_up_reads_gathered_points_as_stored_ones(text):
+    """Stored points, gathered points with the extruder summed in the loop (the planner's way) and gathered
+    points with the summed extruder column handed over give the same set-up, bit for bit."""
     from gcodekit.plan import klipper
+    from gcodekit.plan.points import MoveEnds, RunningSum
 
     op = gcodekit.gcode_to_operation(text, "klipper", plan=False)
     config = klipper.KlipperConfig()
     rows, limits = klipper._velocity_limits(op, config)
     out = []
-    for gathered in (False, True):
-        moves = moves_module.firmware_moves(op, gathered=gathered)
+    for way in ("stored", "summed in the loop", "sums handed over"):
+        moves = moves_module.firmware_moves(op, gathered=way != "stored")
+        if way == "sums handed over":
+            ends = moves.start.ends
+            assert isinstance(ends.columns[3], RunningSum)
+            summed = MoveEnds((*ends.columns[:3], np.cumsum(op.waypoints["de"])), ends.idx, ends.chained)
+            moves = moves_module.PlannerMoves(summed.start, summed.end, moves.speed_v, moves.row, moves.waypoint)
         flush = np.zeros(len(moves), bool)
         flush[0] = True
         out.append(klipper._compiled_moves(kernels.compiled(), moves, rows, limits, config, flush))
-    (stored, stored_junction), (got, got_junction) = out
-    for key in stored:
-        assert_bits_equal(stored[key], got[key], key)
-    assert_bits_equal(stored_junction, got_junction, "junction")
+    (stored, stored_junction), *others = out
+    for got, got_junction in others:
+        for key in stored:
+            assert_bits_equal(stored[key], got[key], key)
+        assert_bits_equal(stored_junction, got_junction, "junction")
+
+
+def test_a_running_sum_reads_as_np_cumsum():
+    from gcodekit.plan.points import RunningSum
+
+    de = np.array([-0.0, 0.1, 0.2, -0.3, 1e-17, 5.0])
+    column = RunningSum(de)
+    assert column._sums is None and len(column) == 6  # nothing summed until read
+    assert_bits_equal(column[np.array([0, 2, 5])], np.cumsum(de)[[0, 2, 5]], "indices")
+    assert_bits_equal(np.asarray(column), np.cumsum(de), "whole")
 
 
 def test_gathered_points_of_a_program_with_arcs_are_stored_chords():

@@ -214,14 +214,17 @@ def _classic_jerk(dx, dy, dz, de, speed_per_mm, nominal_speed, jx, jy, jz, je, r
     return vmax
 
 
-def _klipper_moves(start, end, gathered, wx, wy, wz, we, idx, chained, speed_v, row, flush, limit_rows, max_velocity,
-                   max_accel, square_corner_velocity, minimum_cruise_ratio, initial, z_velocity, z_accel, e_velocity,
-                   e_accel, corner_velocity, extrude_only_accel, no_limit_v2):
+def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, speed_v, row, flush, limit_rows,
+                   max_velocity, max_accel, square_corner_velocity, minimum_cruise_ratio, initial, z_velocity, z_accel,
+                   e_velocity, e_accel, corner_velocity, extrude_only_accel, no_limit_v2):
     """:func:`.klipper._move_block` over all moves: Move.__init__, limit_speed and calc_junction.
 
     The moves' points are ``start`` and ``end``, or, when ``gathered``, the
     waypoint columns ``wx, wy, wz, we`` at the moves' waypoints ``idx`` (as
-    :class:`.points.MoveEnds` takes them, ``chained`` or not).  The limits
+    :class:`.points.MoveEnds` takes them, ``chained`` or not); with
+    ``summing``, ``we`` holds each waypoint's extrusion and the extruder
+    position is its running sum, added up here in ``np.cumsum``'s order as
+    the waypoints come (they only grow).  The limits
     in force come from ``limit_rows`` (sorted) and their columns,
     ``initial`` (max_velocity, max_accel, square_corner_velocity,
     minimum_cruise_ratio) before the first, as :func:`.moves.in_force`.
@@ -238,6 +241,8 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, idx, chained, speed_v, 
     inf = np.inf
     sqrt2_minus_1 = np.sqrt(2.0) - 1.0
     j = 0  # limit rows before the move's row
+    e_at = -1  # with summing: the waypoint the running sum e_sum has reached
+    e_sum = 0.0
     p_kinematic = False
     p_e_r = p_r0 = p_r1 = p_r2 = p_jd = 0.0
     for i in range(n):
@@ -256,10 +261,22 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, idx, chained, speed_v, 
         if gathered:
             w = idx[i]
             v = idx[i - 1] if chained and i > 0 else w - 1  # the waypoint the move starts from
-            if v < 0:
-                dx, dy, dz, de = wx[w] - 0.0, wy[w] - 0.0, wz[w] - 0.0, we[w] - 0.0
+            if summing:
+                while e_at < v:
+                    e_at += 1
+                    e_sum = we[0] if e_at == 0 else e_sum + we[e_at]
+                e_v = e_sum
+                while e_at < w:
+                    e_at += 1
+                    e_sum = we[0] if e_at == 0 else e_sum + we[e_at]
+                e_w = e_sum
             else:
-                dx, dy, dz, de = wx[w] - wx[v], wy[w] - wy[v], wz[w] - wz[v], we[w] - we[v]
+                e_v = we[v] if v >= 0 else 0.0
+                e_w = we[w]
+            if v < 0:
+                dx, dy, dz, de = wx[w] - 0.0, wy[w] - 0.0, wz[w] - 0.0, e_w - 0.0
+            else:
+                dx, dy, dz, de = wx[w] - wx[v], wy[w] - wy[v], wz[w] - wz[v], e_w - e_v
         else:
             dx = end[i, 0] - start[i, 0]
             dy = end[i, 1] - start[i, 1]

@@ -26,6 +26,7 @@ from ..errors import ConfigError
 from ..memory import release_freed_memory
 from .kernels import engine
 from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
+from .points import RunningSum
 from .scans import backward_min, forward_min, next_marked, segmented_cummin
 from .trapezoids import NextEntry, TrapezoidPlan
 
@@ -260,9 +261,12 @@ def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict,
     ends = getattr(moves.start, "ends", None)  # a MoveEnds when the points are gathered from the waypoints
     if ends is None:
         points = (np.ascontiguousarray(moves.start, float), np.ascontiguousarray(moves.end, float), False,
-                  *([np.zeros(0)] * 4), np.zeros(0, np.int32), False)
-    else:
-        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, *(np.asarray(c, float) for c in ends.columns),
+                  *([np.zeros(0)] * 4), False, np.zeros(0, np.int32), False)
+    else:  # the extruder's running sum made as the loop goes, when it is not made already
+        x, y, z, e = ends.columns
+        summing = isinstance(e, RunningSum)
+        e = e.deltas if summing else e
+        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, *(np.asarray(c, float) for c in (x, y, z, e)), summing,
                   ends.idx, ends.chained)
     out = compiled.klipper_moves(
         *points, np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row), flush,

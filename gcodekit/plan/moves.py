@@ -21,7 +21,7 @@ import numpy as np
 from ..emulate import arcs
 from ..parse.table import NAME_ID
 from .kernels import engine
-from .points import MoveEnds, chained
+from .points import MoveEnds, RunningSum, chained
 
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
@@ -307,7 +307,7 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     # length and time are unknown, and firmware time estimates leave them out.
     homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
     compiled = engine(n)
-    e = np.cumsum(w["de"]) if gathered or compiled is None else None
+    e = np.cumsum(w["de"]) if compiled is None else None
     if compiled is not None:  # the same moves and points in one loop, without the temporaries below
         idx, start, end, is_chained = compiled.move_points(w["x"], w["y"], w["z"], w["de"], w["motion"], homing,
                                                            w["distance"], not gathered)
@@ -329,8 +329,8 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     is_arc = w["motion"][idx] >= 3
     rows = _narrow(rows[idx], len(op.table))
     segmenting = arc_segments is not None and bool(is_arc.any())
-    if e is not None:  # the points from the waypoint columns: gathered when asked, else stored
-        ends = MoveEnds((w["x"], w["y"], w["z"], e), idx, is_chained)
+    if gathered or compiled is None:  # the points from the waypoint columns: gathered when asked, else stored
+        ends = MoveEnds((w["x"], w["y"], w["z"], RunningSum(w["de"], e)), idx, is_chained)
         start, end = (ends.start, ends.end) if gathered and not segmenting else ends.arrays()
         del ends, e
     if not segmenting:

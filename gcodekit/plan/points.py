@@ -13,7 +13,36 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MoveEnds", "chained"]
+__all__ = ["MoveEnds", "RunningSum", "chained"]
+
+
+class RunningSum:
+    """A column's running sum (``np.cumsum(deltas)``, the extruder position from each waypoint's ``de``),
+    made when first read.
+
+    Indexed like the array it stands for.  A compiled loop that walks the
+    waypoints in order sums :attr:`deltas` itself (Klipper's set-up), so
+    the 8 bytes per waypoint of the sums are never held at its peak.
+    """
+
+    def __init__(self, deltas: np.ndarray, sums: np.ndarray | None = None):
+        self.deltas = deltas
+        self._sums = sums
+
+    @property
+    def sums(self) -> np.ndarray:
+        if self._sums is None:
+            self._sums = np.cumsum(self.deltas)
+        return self._sums
+
+    def __len__(self) -> int:
+        return int(np.shape(self.deltas)[0])
+
+    def __getitem__(self, index) -> np.ndarray:
+        return self.sums[index]
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        return self.sums if dtype is None else self.sums.astype(dtype)
 
 
 def chained(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> bool:
@@ -31,7 +60,8 @@ def chained(columns: tuple[np.ndarray, ...], idx: np.ndarray) -> bool:
 class MoveEnds:
     """The start and end points (X, Y, Z, E) of the moves ending at waypoints ``idx``.
 
-    ``columns`` are the waypoints' X, Y, Z and extruder position.  When the
+    ``columns`` are the waypoints' X, Y, Z and extruder position (an array
+    or a :class:`RunningSum` of the extrusion per waypoint).  When the
     moves are ``chained``, move ``k`` starts at the end of move ``k - 1``;
     otherwise at the waypoint before its own.  The first move of the program
     starts at the origin.  :attr:`start` and :attr:`end` gather a slice of
