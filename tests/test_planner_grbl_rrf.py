@@ -295,3 +295,16 @@ def test_rrf_preset_plans_the_pipeline():
     op = gcodekit.gcode_to_operation("G1 X100 F3000\n", "reprapfirmware")
     expected = trapezoid_time(100.0, 50.0, min(c.max_acceleration_x, c.max_travel_acceleration))
     assert op.get_statistics()["time_s"] == pytest.approx(expected)
+
+
+def test_rrf_says_when_m203_caps_the_feeds():
+    """RepRapFirmware reads M203 in mm/min (Marlin in mm/s): a Marlin program's ``M203 X200`` caps a 100 mm/s
+    move at 3.3 mm/s.  The info says so, with the time it adds at cruise: 100 mm at 200/60 mm/s instead of
+    100 mm/s, 30 - 1 = 29 s.  Limits in mm/min, as RepRapFirmware's own programs write them, say nothing."""
+    marlin_style = gcodekit.gcode_to_operation("M203 X200 Y200\nG1 X100 F6000\n", "reprapfirmware")
+    said = [d for d in marlin_style.diagnostics if "faster than the machine allows" in d.message]
+    assert len(said) == 1 and said[0].line == 2 and said[0].severity == "info"
+    assert "6000 mm/min against 200 mm/min, M203, in mm/min on RepRapFirmware" in said[0].message
+    assert "adds about 29.0 s" in said[0].message
+    own = gcodekit.gcode_to_operation("M203 X12000 Y12000\nG1 X100 F6000\n", "reprapfirmware")
+    assert not [d for d in own.diagnostics if "faster than the machine allows" in d.message]

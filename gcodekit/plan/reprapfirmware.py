@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import ConfigError
+from .caps import report_feed_caps
 from .lookahead import empty_result, limit_by_axis_maximum, lookahead, trapezoid, unit_vectors
 from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, m204_in_force,
                     settings_in_force, speed_factor)
@@ -245,8 +246,12 @@ def plan(op: "EmulatedProgram", config: RrfConfig) -> tuple[PlannerMoves, PlanRe
     m204 = np.where(is_printing_move, lim["max_printing_acceleration"], lim["max_travel_acceleration"])
     acceleration = np.where(xy_moving, np.minimum(acceleration, m204), acceleration)
     # 6. requested speed: at least the minimum movement speed, then within the axis limits
+    allowed_speed = limit_by_axis_maximum(lim["max_feedrate"], direction_vector)
+    # M203 is mm/min here and mm/s on Marlin: a Marlin program's M203 X200 caps its moves at 3.3 mm/s
+    report_feed_caps(op, moves, allowed_speed, "M203, in mm/min on RepRapFirmware")
     requested_speed = np.minimum(np.maximum(np.nan_to_num(moves.speed_v), lim["minimum_movement_speed"]),
-                                 limit_by_axis_maximum(lim["max_feedrate"], direction_vector))
+                                 allowed_speed)
+    del allowed_speed
 
     # 7. "Try to meld this move to the previous move to avoid stop/start"
     prev = np.r_[0, np.arange(n - 1)]
