@@ -8,10 +8,9 @@ from __future__ import annotations
 from ...units import MM_PER_INCH
 from .registry import Block, Context, handles
 
-#: mm per program unit after G20 / G21
 #: Said once where firmware that sets its feed only from an F above 0 (Marlin) meets F0 or below.
 FEED_AT_OR_BELOW_ZERO = "F at or below 0 sets no feed rate on this firmware: it keeps the one it had"
-
+#: mm per program unit after G20 / G21
 UNITS = {"units_inch": MM_PER_INCH, "units_mm": 1.0}
 _FEED_MODES = {"feed_inverse_time": "inverse_time", "feed_per_minute": "per_minute", "feed_per_rev": "per_rev"}
 #: Switches that only set one state attribute: name -> (attribute, value)
