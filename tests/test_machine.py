@@ -623,7 +623,16 @@ def test_f_at_or_below_zero_leaves_a_printer_firmware_s_feed(flavor):
     assert [(d.line, d.severity) for d in said] == [(2, "warning")]
 
 
-@pytest.mark.parametrize("flavor", ["reprapfirmware", "linuxcnc", "grbl"])
-def test_f0_sets_a_zero_feed_elsewhere(flavor):
+@pytest.mark.parametrize("flavor, said, line", [
+    ("reprapfirmware", "feed move at F0: this firmware takes F0 as written and moves at its minimum movement speed",
+     3),
+    ("linuxcnc", "Cannot do g1 with zero feed rate", 2),  # rs274 refuses the G1 F0 block itself
+    ("grbl", "Cannot do g1 with zero feed rate", 3),
+    ("makerbot", "feed move with no feed rate (F) in force: the controller refuses it", 3),
+])
+def test_f0_sets_a_zero_feed_elsewhere(flavor, said, line):
+    """RepRapFirmware takes F0 as written (``GCodeBuffer::GetSpeed`` checks nothing) and crawls at M203 I:
+    it is not said to refuse the move, as GRBL and LinuxCNC do."""
     op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F0\nG1 X20\n", flavor, plan=False)
     assert op.waypoints["feed"].tolist()[-1] == 0.0 and np.isnan(op.waypoints["time"][-1])
+    assert [d.line for d in op.diagnostics if d.message.startswith(said)] == [line]

@@ -77,12 +77,15 @@ class Machine:
         The waypoints the program may make (one per block, plus the moves
         cycles and threads expand into); at the limit the machine stops with
         an error naming the line (see :mod:`gcodekit.limits`).
+    zero_feed : {"refused", "kept", "minimum_speed"}
+        What the firmware does with an F at or below 0 (see
+        :attr:`gcodekit.syntax.Flavor.zero_feed`).
     """
 
     def __init__(self, config: MachineConfig, diagnostics: Diagnostics | None = None, *,
                  rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = "",
                  rs274_blocks: bool = False, polar_incremental_only: bool = False, max_motions: int = MAX_MOTIONS,
-                 feed_above_zero_only: bool = False):
+                 zero_feed: str = "refused"):
         self.config = config
         self.budget = MotionBudget(max_motions)
         self.out_of_budget = False  # stopped at max_motions: the rest of the program is not run
@@ -92,7 +95,7 @@ class Machine:
         # does, and a word for an axis the machine lacks is an error.  Printer
         # firmware reads F only on moves and U/V/W as flags (Prusa's G28 W).
         self.rs274_blocks = rs274_blocks
-        self.feed_above_zero_only = feed_above_zero_only  # F0 leaves the feed (Marlin)
+        self.zero_feed = zero_feed  # an F at or below 0: "refused", "kept" (Marlin) or "minimum_speed" (RRF)
         self.polar_incremental_only = polar_incremental_only  # GER's G16 rules
         self.state = MachineState()
         self.state.units = mm_per(initial_units)
@@ -123,7 +126,7 @@ class Machine:
         self.modal = ModalHandler(Context(self.state, config, self.diagnostics, self.tools, self.budget,
                                           self.warn_once, rs274_blocks=rs274_blocks,
                                           polar_incremental_only=polar_incremental_only,
-                                          feed_above_zero_only=feed_above_zero_only,
+                                          zero_feed=zero_feed,
                                           rapid_is_feed=self.rapid_is_feed, comp_profile_ends=self.comp_profile_ends))
 
     # -- running ----------------------------------------------------------------
@@ -344,7 +347,7 @@ class Machine:
         feed_words[kind == Kind.COMMENT] = np.nan
         if not self.rs274_blocks:
             feed_words[kind == Kind.M] = np.nan
-        if self.feed_above_zero_only:
+        if self.zero_feed == "kept":
             self._ignore_feed_at_or_below_zero(t, rows, feed_words)
         if s.feed_mode == "inverse_time":
             feed = feed_words  # 1/min, for this block only
@@ -553,6 +556,9 @@ class Machine:
                 if no_spindle[first]:
                     self.warn_once("feed per rev", int(t.line[rows][first]), "feed per revolution (G95) with the "
                                    "spindle stopped: the move never ends (a controller stalls); its time is unknown")
+                elif self.zero_feed == "minimum_speed":
+                    self.warn_once("feed", int(t.line[rows][first]), "feed move at F0: this firmware takes F0 as "
+                                   "written and moves at its minimum movement speed (RepRapFirmware's M203 I)")
                 elif "feed" not in self._warned:
                     # no boot feed (GRBL's error 22, "undefined feed rate"; a Fanuc's feed-zero alarm)
                     self._warned.add("feed")

@@ -111,7 +111,7 @@ class ModalHandler:
         and on Marlin only above 0)."""
         ctx, params = self.context, block.params
         if "F" in params and (block.letter != "M" or ctx.rs274_blocks):
-            if ctx.feed_above_zero_only and not params["F"] > 0:
+            if ctx.zero_feed == "kept" and not params["F"] > 0:
                 ctx.warn_once("feed at or below 0", block.line, FEED_AT_OR_BELOW_ZERO)
                 return
             # an F beside G20/G21 is in the block's new units ("G20 F60" is 60 in/min); where

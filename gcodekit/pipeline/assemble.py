@@ -23,7 +23,7 @@ def new_machine(flavor: Flavor, config: MachineConfig, diagnostics: Diagnostics,
     return Machine(config, diagnostics, rapid_is_feed=flavor.rapid_is_feed, initial_units=flavor.units,
                    initial_extrusion=flavor.extrusion, rs274_blocks=flavor.block_split == "modal",
                    polar_incremental_only=flavor.polar_incremental_only, max_motions=limits.max_motions,
-                   feed_above_zero_only=flavor.feed_above_zero_only)
+                   zero_feed=flavor.zero_feed)
 
 
 def empty_table(parser: GcodeParser, program: Program) -> CommandTable:

@@ -18,6 +18,8 @@ from typing import Mapping
 #: G/M/T word is the command and every other word its parameter;
 #: ``sequential``: GER, every G/M code starts a new statement in text order.
 BLOCK_SPLITS = ("modal", "single", "sequential")
+#: What firmware does with an F at or below 0 (see :attr:`Flavor.zero_feed`).
+ZERO_FEEDS = ("refused", "kept", "minimum_speed")
 
 #: Normalized command names a flavor's ``[codes]`` table may map to.
 COMMANDS = frozenset(
@@ -200,10 +202,14 @@ class Flavor:
         E mode at program start; ``""`` when the dialect does not extrude.
     rapid_is_feed : bool
         G0 moves at the programmed feed (Marlin), not at the rapid rate.
-    feed_above_zero_only : bool
-        An F word at or below 0 leaves the feed rate as it was: Marlin and
-        Prusa's firmware set it only from an F above 0, Klipper refuses the
-        command ("Invalid speed").
+    zero_feed : {"refused", "kept", "minimum_speed"}
+        What the firmware does with an F at or below 0: ``"refused"``, its
+        feed moves are refused (GRBL's error 22, LinuxCNC, a Fanuc's
+        alarm); ``"kept"``, the F is ignored and the feed rate stays (Marlin
+        and Prusa's firmware set it only from an F above 0; Klipper refuses
+        the command, "Invalid speed"); ``"minimum_speed"``, the F is taken
+        and the moves crawl at the minimum movement speed (RepRapFirmware's
+        M203 I).
     initial_motion : {"", "rapid", "linear"}
         Motion mode in force at program start (GER starts in G0), so axis
         words alone move; ``""`` when they need a motion code first.
@@ -246,7 +252,7 @@ class Flavor:
     units: str = "mm"
     extrusion: str = ""
     rapid_is_feed: bool = False
-    feed_above_zero_only: bool = False
+    zero_feed: str = "refused"
     initial_motion: str = ""
     layer_comments: tuple[str, ...] = ()
     feature_comment: str = ""

@@ -21,7 +21,7 @@ from types import MappingProxyType
 from typing import Any
 
 from ..errors import ConfigError, did_you_mean
-from .flavor import BLOCK_SPLITS, COMMANDS, PARAMETERS, DetectRules, Flavor
+from .flavor import BLOCK_SPLITS, COMMANDS, PARAMETERS, ZERO_FEEDS, DetectRules, Flavor
 
 FLAVOR_DIR = Path(__file__).with_name("flavors")
 
@@ -40,6 +40,7 @@ _CHOICES = {
     "extrusion": ("absolute", "relative", ""),
     "comment": (";", "(", ""),
     "initial_motion": ("", "rapid", "linear"),
+    "zero_feed": ZERO_FEEDS,
 }
 
 

@@ -97,7 +97,7 @@ class Context:
     rs274_blocks: bool = False  # RS274NGC block rules (see Machine)
     polar_incremental_only: bool = False  # GER's G16 rules
     rapid_is_feed: bool = False  # G0 moves at the modal feed
-    feed_above_zero_only: bool = False  # an F at or below 0 leaves the feed (Marlin)
+    zero_feed: str = "refused"  # what an F at or below 0 does (see Machine)
     comp_profile_ends: list[tuple[int, np.ndarray]] = field(default_factory=list)
     cycle_mode: CycleMode = field(default_factory=CycleMode)
     splines: SplineBlocks = field(init=False)  # the spline being read, block by block
