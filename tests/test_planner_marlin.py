@@ -455,3 +455,17 @@ def test_vectorized_plan_matches_the_oracle_on_a_real_file():
     moves, result = marlin.plan(op, CLASSIC)
     times, _ = oracle(op, CLASSIC)
     np.testing.assert_allclose(result.duration_t, times, rtol=1e-9, atol=1e-12)
+
+
+def test_a_g0_on_a_machine_whose_rapids_are_not_the_feed_plans_at_the_rapid_rate():
+    """Sailfish moves G0 at the axes' maximum rate (the MakerBot preset's ``rapid_feed``), not at the modal F,
+    and the emulator times it so: the planner must request that speed too.  The G0 plans exactly as the same
+    move written as G1 at the rapid rate (before: at F800, 7.5 s for 100 mm against the emulator's 0.33 s)."""
+    rapid = gcodekit.gcode_to_operation("G1 F800 X10\nG0 X110\n", "makerbot")
+    written = gcodekit.gcode_to_operation("G1 F800 X10\nG1 X110 F18000\n", "makerbot")
+    assert rapid.waypoints["time"].tolist() == written.waypoints["time"].tolist()
+    assert rapid.waypoints["time"][1] < 1.0
+    # where G0 moves at the feed (Marlin), it plans at the feed
+    marlin = gcodekit.gcode_to_operation("G1 F800 X10\nG0 X110\n", "marlin")
+    at_feed = gcodekit.gcode_to_operation("G1 F800 X10\nG1 X110\n", "marlin")
+    assert marlin.waypoints["time"].tolist() == at_feed.waypoints["time"].tolist()
