@@ -11,6 +11,7 @@ module, so later processes load it instead of compiling again.
 
 from __future__ import annotations
 
+import importlib.util
 import sys
 from typing import Any, Callable
 
@@ -29,6 +30,11 @@ def compile_loops(*functions: Callable, **options: Any) -> tuple[Callable, ...] 
         return None
     jit = numba.njit(cache=True, nogil=True, **options)
     return tuple(jit(f) for f in functions)
+
+
+def numba_installed() -> bool:
+    """Whether Numba can be imported (looked up, not imported: the look-up costs nothing at start-up)."""
+    return importlib.util.find_spec("numba") is not None
 
 
 def numba_loaded() -> bool:

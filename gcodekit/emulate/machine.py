@@ -90,7 +90,7 @@ class Machine:
         self.budget = MotionBudget(max_motions)
         self.out_of_budget = False  # stopped at max_motions: the rest of the program is not run
         self.diagnostics = Diagnostics() if diagnostics is None else diagnostics
-        self.rapid_is_feed = config.rapid_is_feed if config.rapid_is_feed is not None else rapid_is_feed
+        self.rapid_is_feed = config.rapids_at_feed(rapid_is_feed)
         # RS274NGC block rules: an F word sets the feed whatever else the block
         # does, and a word for an axis the machine lacks is an error.  Printer
         # firmware reads F only on moves and U/V/W as flags (Prusa's G28 W).

@@ -199,6 +199,10 @@ class MachineConfig:
     def __hash__(self) -> int:
         return hash(self.name)
 
+    def rapids_at_feed(self, flavor_says: bool) -> bool:
+        """Whether G0 moves at the modal F: the preset's ``rapid_is_feed``, else what the flavor says."""
+        return flavor_says if self.rapid_is_feed is None else bool(self.rapid_is_feed)
+
 
 _TYPES = {f.name: f.type for f in fields(MachineConfig)}
 

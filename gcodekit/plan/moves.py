@@ -324,7 +324,8 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
         is_chained = chained(columns, idx)
     del homing
     speed = np.asarray(w["feed"], float)[idx] / 60.0
-    if not _rapids_at_feed(op):  # G0 at the machine's rapid rate (Sailfish), as the emulator times it
+    if not op.machine.rapids_at_feed(op.flavor is None or op.flavor.rapid_is_feed):
+        # G0 at the machine's rapid rate (Sailfish), as the emulator times it
         speed[w["motion"][idx] == MOTION_RAPID] = op.machine.rapid_feed / 60.0
     if speed_factor is not None:
         speed *= speed_factor[idx]
@@ -338,14 +339,6 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     if not segmenting:
         return PlannerMoves(start, end, speed, rows, idx)
     return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows, arc_segments)
-
-
-def _rapids_at_feed(op: "EmulatedProgram") -> bool:
-    """Whether G0 moves at the modal feed on this machine (printer firmware) rather than its rapid rate: the
-    preset's word, else the flavor's (as the emulator decides)."""
-    if op.machine.rapid_is_feed is not None:
-        return bool(op.machine.rapid_is_feed)
-    return op.flavor is None or bool(op.flavor.rapid_is_feed)
 
 
 def _narrow(index: np.ndarray, bound: int) -> np.ndarray:

@@ -14,7 +14,6 @@ Examples
 
 from __future__ import annotations
 
-import importlib.util
 import os
 from pathlib import Path
 from typing import Iterable, Iterator
@@ -22,6 +21,7 @@ from typing import Iterable, Iterator
 import numpy as np
 
 from ..errors import Diagnostics, MissingDependencyError, check_choice
+from ..jit import numba_installed
 from ..syntax import Flavor, load_flavor
 from .blocks import Block, Blocks, Word
 from . import scan_kernel
@@ -74,7 +74,7 @@ def iter_blocks(
 def scans_without_gil(flavor: Flavor) -> bool:
     """Whether the compiled scanner can read ``flavor`` and Numba is installed (looked up, not imported):
     then scanning a chunk releases the GIL, and reading ahead on a second thread pays."""
-    return fast_path_possible(flavor) and importlib.util.find_spec("numba") is not None
+    return fast_path_possible(flavor) and numba_installed()
 
 
 def iter_counted_blocks(chunks: Iterable[bytes], flavor: Flavor, diagnostics: Diagnostics, *, engine: str = "auto",
