@@ -146,3 +146,36 @@ def test_a_move_planned_at_no_speed_has_an_unknown_time():
     v, accel = 800 / 60, 3000.0  # Klipper's default max_accel: 10 mm from rest to rest, cruising at v
     assert np.isnan(t[2]) and t[0] == pytest.approx(10 / v + v / accel, rel=1e-12)
     assert not any("years" in d.message for d in op.diagnostics)
+
+
+@pytest.mark.parametrize("machine, program, speed_by_line", [
+    # M220 scales the feed from its row on (S / 100, as the planner reads it); an arc cut into chords
+    # repeats its line's speed
+    ("marlin", "M220 S50\nG1 X10 F1200\nG2 X20 I5 F600\nM220 S150\nG1 X30 Y5\nG1 E2 F300\n",
+     {2: 1200 / 60.0 * 0.5, 3: 600 / 60.0 * 0.5, 5: 600 / 60.0 * 1.5, 6: 300 / 60.0 * 1.5}),
+    ("klipper", "G1 X10 F1200\nG3 X0 Y0 I-5 J0 F900\nM220 S80\nG1 X5 Y5 F3000\n",
+     {1: 1200 / 60.0, 2: 900 / 60.0, 4: 3000 / 60.0 * 0.8}),
+    # Sailfish's G0 at the preset's rapid rate, 18000 mm/min, not the feed
+    ("makerbot", "G1 F800 X10\nG0 X110\nG1 X120 F600\n", {1: 800 / 60.0, 2: 18000 / 60.0, 3: 600 / 60.0}),
+])
+def test_kept_moves_read_their_speeds_and_rows_again(machine, program, speed_by_line):
+    """Marlin's and Klipper's plans keep no speed or row per move: read back from the waypoint columns, each
+    move's row is its line's and its speed the one worked out by hand, and a slice of them is the slice.
+    (That the values are those the planner was handed, bit for bit, the corpus plans' hashes showed.)"""
+    op = gcodekit.gcode_to_operation(program, machine)
+    kept, _ = op.plan
+    assert kept.source is not None and len(kept) >= len(speed_by_line)
+    lines = op.table.line[kept.row]
+    assert set(lines.tolist()) == set(speed_by_line)
+    assert kept.speed_v.tolist() == [speed_by_line[line] for line in lines.tolist()]
+    assert kept.speeds(slice(1, 3)).tolist() == kept.speed_v[1:3].tolist()
+    assert kept.speeds(np.array([0, len(kept) - 1])).tolist() == kept.speed_v[[0, -1]].tolist()
+
+
+def test_moves_read_from_the_waypoints_cannot_be_changed_apart_from_them():
+    op = gcodekit.gcode_to_operation("G1 X10 F1200\nG1 X20\n", "marlin", plan=False)
+    moves = plan.moves.firmware_moves(op)
+    with pytest.raises(ValueError):
+        moves.speed_v[0] = 1.0
+    with pytest.raises(ValueError, match="source"):
+        PlannedMoves(None, None, moves.waypoint, np.ones(len(moves)))

@@ -228,7 +228,7 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
         for lo in range(0, n, BLOCK):
             hi = min(lo + BLOCK, n)
             _move_block(moves, rows, limits, config, flush, lo, hi, m, junction)
-    planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, m["move_d"])
+    planned = moves.planned(m["move_d"])  # the speeds and rows read again when asked: two arrays fewer
     del moves  # the end points are no longer needed: free them before the passes
     release_freed_memory()
 

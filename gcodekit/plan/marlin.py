@@ -303,7 +303,7 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
         _populate_blocks(moves, lim, rest_before, config, lo, min(lo + BLOCK, n), block, compiled)
     del lim
     millimeters, acceleration = block["millimeters"], block["acceleration"]
-    planned = PlannedMoves(moves.speed_v, moves.row, moves.waypoint, millimeters)
+    planned = moves.planned(millimeters)  # the speeds and rows read again when asked: two arrays fewer
     del moves  # the end points are no longer needed: free them before the passes
     release_freed_memory()
     minimum_planner_speed_sqr = config.minimum_planner_speed**2

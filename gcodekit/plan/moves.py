@@ -31,6 +31,37 @@ if TYPE_CHECKING:
 ArcRule = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
 
+@dataclass(frozen=True)
+class MoveSource:
+    """The waypoint columns :func:`firmware_moves` reads each move's requested speed and command row from.
+
+    A planner's kept moves (:class:`PlannedMoves`) hold these columns, which
+    the operation keeps anyway, instead of two arrays per move (36 MB on a
+    3 M-move print), and read the values again, bit for bit, when asked.
+    """
+
+    feed: np.ndarray
+    command: np.ndarray
+    motion: np.ndarray
+    rapid_v: float | None
+    factor: np.ndarray | None
+    n_rows: int
+
+    def speed_v(self, waypoint: np.ndarray) -> np.ndarray:
+        """Requested speed (mm/s) of the moves of ``waypoint``: the feed over 60 (G0 at ``rapid_v`` when it is
+        not the feed), times the speed factor."""
+        speed = np.asarray(self.feed, float)[waypoint] / 60.0
+        if self.rapid_v is not None:  # G0 at the machine's rapid rate (Sailfish), as the emulator times it
+            speed[self.motion[waypoint] == MOTION_RAPID] = self.rapid_v
+        if self.factor is not None:
+            speed *= self.factor[waypoint]
+        return speed
+
+    def row(self, waypoint: np.ndarray) -> np.ndarray:
+        """Command row of the moves of ``waypoint``."""
+        return _narrow(self.command[waypoint], self.n_rows)
+
+
 @dataclass
 class PlannerMoves:
     """Straight moves in the order the firmware receives them.
@@ -47,6 +78,9 @@ class PlannerMoves:
         Command row each move comes from.
     waypoint : ndarray of int32 (int64 past 2**31 waypoints)
         Waypoint each move belongs to (several for a segmented arc).
+    source : MoveSource, optional
+        Where ``speed_v`` and ``row`` were read (moves straight from
+        :func:`firmware_moves`; moves changed since have none).
     """
 
     start: np.ndarray
@@ -54,6 +88,12 @@ class PlannerMoves:
     speed_v: np.ndarray
     row: np.ndarray
     waypoint: np.ndarray
+    source: MoveSource | None = None
+
+    def __post_init__(self):
+        if self.source is not None:  # what the source gives: changing them would part them from it
+            for values in (self.speed_v, self.row):
+                values.flags.writeable = False
 
     def __len__(self) -> int:
         return int(self.row.size)
@@ -70,15 +110,19 @@ class PlannerMoves:
             start, end = np.asarray(self.start)[keep], np.asarray(self.end)[keep]
         return PlannerMoves(start, end, self.speed_v[keep], self.row[keep], self.waypoint[keep])
 
-    def planned(self) -> "PlannedMoves":
-        """What an operation keeps after planning: no end points, just each move's length."""
-        axes_d = self.axes_d
-        length_d = np.sqrt(np.einsum("ij,ij->i", axes_d[:, :3], axes_d[:, :3]))
-        length_d = np.where(length_d > 0, length_d, np.abs(axes_d[:, 3]))  # extruder-only moves
+    def planned(self, length_d: np.ndarray | None = None) -> "PlannedMoves":
+        """What an operation keeps after planning: no end points, just each move's length (``length_d``, the
+        planner's, or computed from the end points), and the speeds and rows read from :attr:`source` when
+        there is one."""
+        if length_d is None:
+            axes_d = self.axes_d
+            length_d = np.sqrt(np.einsum("ij,ij->i", axes_d[:, :3], axes_d[:, :3]))
+            length_d = np.where(length_d > 0, length_d, np.abs(axes_d[:, 3]))  # extruder-only moves
+        if self.source is not None:
+            return PlannedMoves(None, None, self.waypoint, length_d, source=self.source)
         return PlannedMoves(self.speed_v, self.row, self.waypoint, length_d)
 
 
-@dataclass
 class PlannedMoves:
     """The planned moves an operation keeps (``op.plan``), a quarter of :class:`PlannerMoves`' size.
 
@@ -90,15 +134,35 @@ class PlannedMoves:
         Command row and waypoint each move comes from.
     length_d : ndarray
         Toolhead travel (mm); the extruder's for extruder-only moves.
+
+    Given a ``source`` instead of ``speed_v`` and ``row``, those two are read
+    from the waypoint columns at each move's waypoint, on every access.
     """
 
-    speed_v: np.ndarray
-    row: np.ndarray
-    waypoint: np.ndarray
-    length_d: np.ndarray
+    def __init__(self, speed_v: np.ndarray | None, row: np.ndarray | None, waypoint: np.ndarray,
+                 length_d: np.ndarray, *, source: MoveSource | None = None):
+        if source is None and (speed_v is None or row is None):
+            raise ValueError("planned moves need their speeds and rows, or the source to read them from")
+        self._speed_v, self._row, self.source = speed_v, row, source
+        self.waypoint, self.length_d = waypoint, length_d
+
+    @property
+    def speed_v(self) -> np.ndarray:
+        return self._speed_v if self._speed_v is not None else self.source.speed_v(self.waypoint)
+
+    @property
+    def row(self) -> np.ndarray:
+        return self._row if self._row is not None else self.source.row(self.waypoint)
+
+    def speeds(self, sel: slice | np.ndarray) -> np.ndarray:
+        """The requested speeds of the moves ``sel``, without reading every move's."""
+        return self._speed_v[sel] if self._speed_v is not None else self.source.speed_v(self.waypoint[sel])
 
     def __len__(self) -> int:
-        return int(self.row.size)
+        return int(self.waypoint.size)
+
+    def __repr__(self) -> str:
+        return f"PlannedMoves({len(self)} moves)"
 
 
 @dataclass
@@ -323,22 +387,20 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
         del changed
         is_chained = chained(columns, idx)
     del homing
-    speed = np.asarray(w["feed"], float)[idx] / 60.0
-    if not op.machine.rapids_at_feed(op.flavor is None or op.flavor.rapid_is_feed):
-        # G0 at the machine's rapid rate (Sailfish), as the emulator times it
-        speed[w["motion"][idx] == MOTION_RAPID] = op.machine.rapid_feed / 60.0
-    if speed_factor is not None:
-        speed *= speed_factor[idx]
+    rapids_at_feed = op.machine.rapids_at_feed(op.flavor is None or op.flavor.rapid_is_feed)
+    source = MoveSource(w["feed"], rows, w["motion"], None if rapids_at_feed else op.machine.rapid_feed / 60.0,
+                        speed_factor, len(op.table))
+    speed = source.speed_v(idx)
     is_arc = w["motion"][idx] >= 3
-    rows = _narrow(rows[idx], len(op.table))
+    rows = source.row(idx)
     segmenting = arc_segments is not None and bool(is_arc.any())
     if gathered or compiled is None:  # the points from the waypoint columns: gathered when asked, else stored
         ends = MoveEnds((w["x"], w["y"], w["z"], RunningSum(w["de"], e)), idx, is_chained)
         start, end = (ends.start, ends.end) if gathered and not segmenting else ends.arrays()
         del ends, e
     if not segmenting:
-        return PlannerMoves(start, end, speed, rows, idx)
-    return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows, arc_segments)
+        return PlannerMoves(start, end, speed, rows, idx, source)
+    return _with_segmented_arcs(op, idx, is_arc, start, end, speed, rows, arc_segments, source)
 
 
 def _narrow(index: np.ndarray, bound: int) -> np.ndarray:
@@ -374,7 +436,8 @@ def _chords_within_limit(op, chords: np.ndarray, angle: np.ndarray, rows: np.nda
     return counts
 
 
-def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc_segments) -> PlannerMoves:
+def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc_segments,
+                         source: MoveSource) -> PlannerMoves:
     """Replace each arc waypoint by its chords (Klipper's and Marlin's plan_arc)."""
     w = op.waypoints
     counts = np.ones(idx.size, np.int64)
@@ -429,7 +492,7 @@ def _with_segmented_arcs(op, idx, is_arc, move_start, move_end, speed, rows, arc
     start_all = np.vstack([move_start[:1], end_all[:-1]])
     first = np.cumsum(counts) - counts
     start_all[first] = move_start
-    return PlannerMoves(start_all, end_all, speed[owner], rows[owner], idx[owner])
+    return PlannerMoves(start_all, end_all, speed[owner], rows[owner], idx[owner], source)
 
 
 def with_kept_steps(w, moves: PlannerMoves, result: PlanResult, kept: np.ndarray) -> tuple[PlannerMoves, PlanResult]:

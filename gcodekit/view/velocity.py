@@ -163,5 +163,5 @@ class VelocityMoves:
             cruise_v = r.cruise_v
             return np.column_stack([r.start_v, cruise_v, cruise_v, r.end_v])
         if name == "commanded":
-            return np.repeat(self.moves.speed_v[sel], 4)
+            return np.repeat(self.moves.speeds(sel), 4)
         raise ValueError(f"no corner column {name!r}: choose from {', '.join(COLUMNS)}")
