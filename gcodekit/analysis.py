@@ -23,7 +23,7 @@ import numpy as np
 from .export.events import event_series, gcode_dataframe_to_event_series
 from .model.derived import depositing, depositing_of, features, layers, row_labels, screw_extruder, waypoint_rows
 from .model.statistics import operation_statistics
-from .parse.table import NAME_ID as NAME_ID_LOOKUP
+from .parse.table import NAME_ID as NAME_ID_LOOKUP, in_ids
 
 __all__ = ["time_by", "slicer_layer_times", "velocity_profile", "velocity_corners", "part_name", "tool_vectors", "ded_moves", "depositing", "depositing_of",
            "features", "layers", "screw_extruder", "waypoint_rows", "operation_statistics", "event_series",
@@ -182,7 +182,7 @@ def ded_moves(op: "Operation") -> "pd.DataFrame":
     t, w = op.table, op.waypoints
     rows = waypoint_rows(op)
     names = t.name[rows]
-    straight = np.isin(names, [NAME_ID_LOOKUP["rapid"], NAME_ID_LOOKUP["linear"]])
+    straight = in_ids(names, [NAME_ID_LOOKUP["rapid"], NAME_ID_LOOKUP["linear"]])
     full = np.ones(rows.size, bool)
     for letter in "XYZ":
         full &= ~np.isnan(t.param(letter)[rows])

@@ -142,10 +142,10 @@ def relative_e_suspect(op: "Operation") -> tuple[int, int, int] | None:
     moves this returns the first such move's source line and the counts.
     None when the program sets the E mode itself (M82/M83) or looks absolute.
     """
-    from ..parse.table import NAME_ID
+    from ..parse.table import NAME_ID, in_ids
 
     t, w = op.table, op.waypoints
-    if np.isin(t.name, [NAME_ID["extrude_absolute"], NAME_ID["extrude_relative"]]).any():
+    if in_ids(t.name, [NAME_ID["extrude_absolute"], NAME_ID["extrude_relative"]]).any():
         return None
     de = programmed_e(w)
     moving = (np.asarray(w["motion"]) >= 2) & (np.asarray(w["distance"]) > 0) & (de != 0)

@@ -195,11 +195,11 @@ def _with_slicer_limits(op: Operation, settings, chosen: bool):
     Cura keeps them in its printer definition, outside the file: when the
     user ``chosen`` no machine, an info says so.
     """
-    from ..parse.table import NAME_ID
+    from ..parse.table import NAME_ID, in_ids
     from ..plan.marlin import limits_from_slicer
 
     codes = [NAME_ID[n] for n in ("set_max_accel", "set_max_feed", "set_accel", "set_jerk")]
-    if np.isin(op.table.name, codes).any():
+    if in_ids(op.table.name, codes).any():
         return settings
     figures = op.slicer_figures()
     limits = limits_from_slicer(figures.settings)

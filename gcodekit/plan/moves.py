@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from ..emulate import arcs
-from ..parse.table import MOTION_RAPID, NAME_ID
+from ..parse.table import MOTION_RAPID, NAME_ID, in_ids
 from .kernels import engine
 from .points import MoveEnds, RunningSum, chained
 
@@ -199,7 +199,7 @@ def command_rows(op: "EmulatedProgram", *, names: tuple[str, ...] = (), codes: t
     mask = np.zeros(len(t), bool)
     ids = [NAME_ID[n] for n in names if n in NAME_ID]
     if ids:
-        mask |= np.isin(t.name, ids)
+        mask |= in_ids(t.name, ids)
     for code in codes:
         m = re.fullmatch(r"([GMT])(\d+)(?:\.(\d))?", code)
         if m:  # compare letter and number columns, no strings per row
@@ -369,7 +369,7 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     rows = w["command"]
     # Homing moves go to an endstop from wherever the axis really is: their
     # length and time are unknown, and firmware time estimates leave them out.
-    homing = np.isin(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
+    homing = in_ids(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
     compiled = engine(n)
     e = np.cumsum(w["de"]) if compiled is None else None
     if compiled is not None:  # the same moves and points in one loop, without the temporaries below

@@ -49,7 +49,7 @@ from ..export.gcode import format_number
 from ..emulate.machine import mode_rows
 from ..parse.commands import Kind
 from ..lathe_profile import written_comment
-from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, NAME_ID, NAMES
+from ..parse.table import CYCLE_NAMES, LATHE_CYCLE_NAMES, MOTION_CYCLE, MOTION_LINEAR, NAME_ID, NAMES, in_ids
 from ..units import MM_PER_INCH
 from .cycle_words import cycle_offset, diameter_words, lathe_defaults, length_words, level_words, rewrite_profile
 
@@ -106,7 +106,7 @@ class Transpiler:
         self._rotary_axes = [a for a in "ABC" if np.any(np.asarray(w[a.lower()]) != 0)]  # written when used
         self._arc_absolute_rows = mode_rows(self.op.table, "arc_distance_absolute", "arc_distance_incremental")
         # the last cycle command at or before each row (axis words alone repeat it)
-        cycles = np.isin(self.op.table.name, [NAME_ID[n] for n in CYCLE_NAMES])
+        cycles = in_ids(self.op.table.name, [NAME_ID[n] for n in CYCLE_NAMES])
         self._last_cycle_row = np.maximum.accumulate(np.where(cycles, np.arange(len(cycles)), 0)) \
             if len(cycles) else np.zeros(0, int)
         # G7: X words are diameters, except G10's (as rs274 reads them)

@@ -56,6 +56,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .geometry import CONCAVE_CORNER
+from ...parse.table import in_ids
 from .states import SIDES, Compensator
 
 if TYPE_CHECKING:
@@ -66,7 +67,7 @@ __all__ = ["CONCAVE_CORNER", "compensate", "uses_compensation"]
 
 def uses_compensation(op: "EmulatedProgram") -> bool:
     """Whether the program switches compensation on (G41, G42, G41.1 or G42.1) anywhere."""
-    return bool(np.isin(op.table.name, [k for k, side in SIDES.items() if side]).any())
+    return bool(in_ids(op.table.name, [k for k, side in SIDES.items() if side]).any())
 
 
 def compensate(op: "EmulatedProgram", tools, profile_ends: list[tuple[int, np.ndarray]] = ()) -> None:

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ...parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID
+from ...parse.table import MOTION_CCW, MOTION_CW, MOTION_LINEAR, MOTION_NONE, MOTION_RAPID, NAME_ID, in_ids
 from ...units import MM_PER_INCH
 from ..arcs import PLANES
 from .geometry import (CONCAVE_CORNER, TINY, OffsetArc, OffsetLine, OffsetMove, OffsetPath, angle_between,
@@ -92,7 +92,7 @@ class Compensator:
         self.columns = self.out.columns
         self.profile_ends = list(profile_ends)
         t = self.table
-        self.side_rows = {int(r): SIDES[int(t.name[r])] for r in np.flatnonzero(np.isin(t.name, list(SIDES)))}
+        self.side_rows = {int(r): SIDES[int(t.name[r])] for r in np.flatnonzero(in_ids(t.name, list(SIDES)))}
         self.tool_changes = set(np.flatnonzero(t.name == NAME_ID["tool_change"]).tolist())
 
         self.state = State.OFF
