@@ -353,7 +353,7 @@ def test_the_preprocessor_never_crashes_on_the_corpus():
 
 # -- properties -----------------------------------------------------------------------------------
 
-from hypothesis import given, settings  # noqa: E402
+from hypothesis import example, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 #: no wall-clock limit: the machine is shared and a first call imports modules
@@ -378,6 +378,7 @@ def test_what_topath_writes_reads_back_to_the_same_commands(commands):
 
 @NO_DEADLINE
 @given(st.lists(st.tuples(_names, _params), max_size=12))
+@example([("G2", {"X": -1.0, "J": 1.0})])  # its end is off the circle: the arc rises to y = 1 - cos(45 deg)
 def test_freecads_length_and_box_never_exceed_the_exact_box(commands):
     """FreeCAD's sampled box lies inside the exact one: every sampled point is on the path."""
     path = gpath.Path([gpath.Command(n, p) for n, p in commands])
@@ -417,3 +418,11 @@ def test_exact_arc_length_is_the_pipelines(plane, arcs):
     op = gpath.to_operation(path, plan=False)
     assert not op.diagnostics.errors, [str(d) for d in op.diagnostics.errors]
     assert path.Length == pytest.approx(float(op.waypoints["distance"].sum()), rel=1e-6)
+
+
+def test_an_arc_whose_end_is_off_its_circle_is_boxed_where_it_turns():
+    """G2 from the origin about (0, 1) toward (-1, 0), which lies 1.414 from the centre: the tool turns 45
+    degrees at radius 1, to (-0.707, 0.293), and steps on to the end (as Marlin's and GRBL's arcs do)."""
+    box = gpath.Path([gpath.Command("G2", {"X": -1.0, "J": 1.0})]).BoundBox
+    turned = 1.0 - math.cos(math.pi / 4)
+    assert box.as_list() == pytest.approx([-1.0, 0.0, 0.0, 0.0, turned, 0.0], abs=1e-12)

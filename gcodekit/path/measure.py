@@ -75,13 +75,22 @@ class Segment:
         return float(sum(np.linalg.norm(q - p) for p, q in zip(pts, pts[1:])))
 
     def extreme_points(self) -> np.ndarray:
-        """The points whose box is the segment's box: ends, drilling corners, an arc's quadrant points."""
+        """The points whose box is the segment's box: ends, drilling corners, an arc's quadrant points.
+
+        An arc turns at its start's radius; an end off that circle (a radius
+        LinuxCNC refuses, which printers and GRBL reach by a last straight
+        step) adds where the arc itself ends.
+        """
         pts = [self.start, *self.points, self.end]
         if self.kind.startswith("arc"):
             a, b, n = self.plane
             r = math.hypot(self.start[a] - self.center[a], self.start[b] - self.center[b])
             t0 = math.atan2(self.start[b] - self.center[b], self.start[a] - self.center[a])
             sign = -1.0 if self.kind == "arc_cw" else 1.0
+            arc_end = np.array(self.end, dtype=float)
+            arc_end[a] = self.center[a] + r * math.cos(t0 + sign * self.sweep)
+            arc_end[b] = self.center[b] + r * math.sin(t0 + sign * self.sweep)
+            pts.append(arc_end)
             for q in range(-8, 9):  # axis directions crossed within the sweep
                 t = q * math.pi / 2
                 d = (t - t0) * sign % (2 * math.pi)
