@@ -90,3 +90,13 @@ def test_radius_arcs_are_rejected_like_klipper():
     op = gcodekit.gcode_to_operation("G1 X10 F6000\nG2 X20 Y0 R5\nG1 X30\n", "klipper", machine_config=CONFIG)
     assert op.motions()["x"].tolist() == [10.0, 30.0]
     assert [d.line for d in op.diagnostics if "R-form" in d.message] == [2]
+
+
+def test_a_move_refused_for_its_speed_leaves_the_next_to_start_where_the_tool_is():
+    """Klipper refuses ``G1 X20 F0`` ("Invalid speed") and takes its gcode position back from the toolhead
+    (gcode_move.py ``reset_last_position`` on ``gcode:command_error``): X13 goes 3 mm on from X10, in one
+    line with it, not 7 mm back from X20.  Rest to rest at 800 mm/min and 3000 mm/s^2 (the preset's)."""
+    op = gcodekit.gcode_to_operation("G1 X10 F800\nG1 X20 F0\nG1 X13\n", "klipper")
+    v, accel = 800 / 60, 3000.0
+    assert op.motions()["x"].tolist() == [10.0, 13.0]
+    assert op.waypoints["time"].sum() == pytest.approx(13 / v + v / accel, rel=1e-12)

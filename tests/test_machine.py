@@ -610,11 +610,12 @@ def test_the_no_tool_table_warning_names_linuxcnc_only_on_linuxcnc(machine, name
     assert ("LinuxCNC" in warning.message) == names_linuxcnc
 
 
-@pytest.mark.parametrize("flavor", ["marlin", "klipper", "prusa_mk3s"])
+@pytest.mark.parametrize("flavor", ["marlin", "prusa_mk3s", "bambu"])
 def test_f_at_or_below_zero_leaves_a_printer_firmware_s_feed(flavor):
-    """Marlin's gcode.cpp sets the feed only when ``parser.floatval('F') > 0`` (Prusa's firmware likewise;
-    Klipper refuses the command): a move after ``G1 F0`` or ``F-5`` runs at the feed before, on moves and on
-    the blocks the modal handler runs (G92, G28).  Said once, at the first such F."""
+    """Marlin's gcode.cpp sets the feed only when ``parser.floatval('F') > 0`` (in
+    ``get_destination_from_command``; Prusa's and Bambu's firmware likewise): a move after ``G1 F0`` or
+    ``F-5`` runs at the feed before, on moves and on the blocks the modal handler runs (G92, G28).  Said once,
+    at the first such F."""
     text = "G1 F800 X10\nG1 F0\nG0 Z3\nG92 E0 F0\nG28 X F-5\nG1 X20 F-5\nG1 X30\n"
     op = gcodekit.gcode_to_operation(text, flavor, plan=False)
     assert op.waypoints["feed"].tolist() == [800.0] * len(op.waypoints["feed"])
@@ -624,15 +625,59 @@ def test_f_at_or_below_zero_leaves_a_printer_firmware_s_feed(flavor):
 
 
 @pytest.mark.parametrize("flavor, said, line", [
-    ("reprapfirmware", "feed move at F0: this firmware takes F0 as written and moves at its minimum movement speed",
-     3),
     ("linuxcnc", "Cannot do g1 with zero feed rate", 2),  # rs274 refuses the G1 F0 block itself
     ("grbl", "Cannot do g1 with zero feed rate", 3),
     ("makerbot", "feed move with no feed rate (F) in force: the controller refuses it", 3),
 ])
 def test_f0_sets_a_zero_feed_elsewhere(flavor, said, line):
-    """RepRapFirmware takes F0 as written (``GCodeBuffer::GetSpeed`` checks nothing) and crawls at M203 I:
-    it is not said to refuse the move, as GRBL and LinuxCNC do."""
     op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F0\nG1 X20\n", flavor, plan=False)
     assert op.waypoints["feed"].tolist()[-1] == 0.0 and np.isnan(op.waypoints["time"][-1])
     assert [d.line for d in op.diagnostics if d.message.startswith(said)] == [line]
+
+
+def test_reprapfirmware_moves_at_f0_at_its_minimum_movement_speed():
+    """RepRapFirmware takes F0 as written (``GCodeBuffer::GetSpeed`` checks nothing) and moves at its
+    minimum movement speed (``DDA::InitStandardMove``: ``max(feedRate, MinMovementSpeed)``): the preset's
+    M203 I30, 0.5 mm/s, until the program's M203 I120, 2 mm/s.  The feed column keeps the F as written;
+    it is not said to refuse the move, as GRBL and LinuxCNC do."""
+    op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F0\nG1 X13\nG0 Z3\nM203 I120\nG1 X19\nG1 X20 F6\n",
+                                     "reprapfirmware", plan=False)
+    w = op.waypoints
+    assert w["feed"].tolist() == [800.0, 0.0, 0.0, 0.0, 0.0, 0.0, 6.0]
+    np.testing.assert_allclose(w["time"], [10 / (800 / 60), 0.0, 3 / 0.5, 3 / 0.5, 0.0, 6 / 2.0, 1 / 2.0])
+    (said,) = [d for d in op.diagnostics if d.message.startswith("feed move at F0")]
+    assert said.line == 3 and said.message.endswith("(RepRapFirmware's M203 I), 30 mm/min here")
+
+
+def test_a_minimum_movement_speed_the_machine_does_not_give_leaves_f0_moves_untimed():
+    # RepRapFirmware's flavor on Klipper's preset, whose planner has no minimum movement speed
+    op = gcodekit.gcode_to_operation("G1 F800 X10\nG1 F0\nG1 X13\n", "klipper", flavor="reprapfirmware",
+                                     plan=False)
+    assert np.isnan(op.waypoints["time"][-1])
+    (said,) = [d for d in op.diagnostics if d.message.startswith("feed move at F0")]
+    assert said.line == 3 and said.message.endswith("which this machine does not give: its time is unknown")
+
+
+def test_klipper_refuses_a_move_at_f0_or_below():
+    """Klipper's gcode_move.py ``cmd_G1`` raises "Invalid speed" for F <= 0 after reading the axis words;
+    the ``gcode:command_error`` event resets ``last_position`` to the toolhead's, which never moved.  So the
+    block makes no move and drops its words (an absolute X20 and a relative X5 alike), the feed stays 800,
+    and the next move starts where the tool is; an arc passes its F to its first segment (gcode_arcs.py).
+    G92 and G28 read no F: only the warning that the F sets nothing."""
+    text = ("G1 F800 X10\nG1 X20 Y5 E1 F0\nG1 Y3\nG92 E0 F0\nG91\nG1 X5 F-5\nG1 X1\nG90\n"
+            "G2 X14 Y7 I2 J2 F0\nG1 F0\nG1 Y0\n")
+    op = gcodekit.gcode_to_operation(text, "klipper", plan=False)
+    w = op.waypoints
+    moved = np.flatnonzero(w["motion"] > 0)
+    assert op.table.line[w["command"][moved]].tolist() == [1, 3, 7, 11]
+    assert list(zip(w["x"][moved], w["y"][moved])) == [(10, 0), (10, 3), (11, 3), (11, 0)]
+    assert (w["feed"] == 800.0).all() and w["de"].sum() == 0.0
+    np.testing.assert_allclose(w["time"][moved], np.array([10, 3, 1, 3]) / (800 / 60))
+    errors = [d for d in op.diagnostics if d.severity == "error"]
+    assert [d.line for d in errors] == [2, 6, 9, 10]
+    assert errors[0].message.startswith("Invalid speed: Klipper refuses a move with F at or below 0")
+    assert errors[0].message.endswith("a print from its virtual SD card stops here")
+    assert [(d.line, d.severity) for d in op.diagnostics if d.message.startswith("F at or below 0")] == \
+        [(4, "warning")]
+    with pytest.raises(gcodekit.errors.GcodeMachineError, match="<string>:2:1: error: Invalid speed"):
+        gcodekit.gcode_to_operation(text, "klipper", mode="strict", plan=False)

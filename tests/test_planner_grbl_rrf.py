@@ -308,3 +308,16 @@ def test_rrf_says_when_m203_caps_the_feeds():
     assert "adds about 29.0 s" in said[0].message
     own = gcodekit.gcode_to_operation("M203 X12000 Y12000\nG1 X100 F6000\n", "reprapfirmware")
     assert not [d for d in own.diagnostics if "faster than the machine allows" in d.message]
+
+
+def test_rrf_plans_moves_at_f0_at_the_minimum_movement_speed():
+    """After ``G1 F0`` RepRapFirmware moves at M203 I (``DDA::InitStandardMove``), G1 as G0: each waypoint
+    has the planner's time, not an unknown one.  The preset's 0.5 mm/s is below M566's 10 mm/s, so X13
+    joins the X10 travel move at it and brakes to rest before the Z move (not an XY move)."""
+    op = gcodekit.gcode_to_operation("G1 X10 F800\nG1 F0\nG1 X13\nG0 Z3\n", "reprapfirmware")
+    c = planner_settings("reprapfirmware", gcodekit.load_machine("reprapfirmware").planner_settings)
+    v = c.minimum_movement_speed / 60.0
+    x13 = trapezoid_time(3.0, v, min(c.max_acceleration_x, c.max_travel_acceleration), v0=v)
+    z3 = trapezoid_time(3.0, v, c.max_acceleration_z)
+    assert v == 0.5 and x13 == pytest.approx(6.0 + 0.5 / 1500 - 0.25 / 3000 / 0.5, rel=1e-12)
+    np.testing.assert_allclose(op.waypoints["time"][2:], [x13, z3], rtol=1e-9)

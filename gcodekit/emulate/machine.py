@@ -40,6 +40,10 @@ from .tooltable import ToolTable
 _MOVING = np.array(sorted({Kind.MOVE, Kind.ARC, Kind.MOVE_EXTRUDE, Kind.ARC_EXTRUDE, Kind.MOVE_MILL,
                            Kind.ARC_MILL, Kind.EXTRUDE}), np.uint8)
 _MILL = np.array([Kind.MILL, Kind.MOVE_MILL, Kind.ARC_MILL], np.uint8)
+_G0_TO_G3 = np.array(sorted(NAME_ID[n] for n in ("rapid", "linear", "arc_cw", "arc_ccw")), np.uint8)
+#: Said at each G0-G3 with an F at or below 0 on firmware whose zero_feed is "stops" (Klipper).
+INVALID_SPEED = ("Invalid speed: Klipper refuses a move with F at or below 0, which is not made (its axis words are "
+                 "dropped, the feed stays); a print from its virtual SD card stops here")
 
 
 def _held(values: np.ndarray, before: float) -> np.ndarray:
@@ -77,15 +81,19 @@ class Machine:
         The waypoints the program may make (one per block, plus the moves
         cycles and threads expand into); at the limit the machine stops with
         an error naming the line (see :mod:`gcodekit.limits`).
-    zero_feed : {"refused", "kept", "minimum_speed"}
+    zero_feed : {"refused", "kept", "minimum_speed", "stops"}
         What the firmware does with an F at or below 0 (see
         :attr:`gcodekit.syntax.Flavor.zero_feed`).
+    minimum_feed : float, default: 0
+        mm/min; where ``zero_feed`` is ``"minimum_speed"``, the slowest the
+        firmware moves, however low the feed (RepRapFirmware's M203 I, which
+        the program may change); 0 when not known: moves at F0 are untimed.
     """
 
     def __init__(self, config: MachineConfig, diagnostics: Diagnostics | None = None, *,
                  rapid_is_feed: bool = False, initial_units: str = "mm", initial_extrusion: str = "",
                  rs274_blocks: bool = False, polar_incremental_only: bool = False, max_motions: int = MAX_MOTIONS,
-                 zero_feed: str = "refused"):
+                 zero_feed: str = "refused", minimum_feed: float = 0.0):
         self.config = config
         self.budget = MotionBudget(max_motions)
         self.out_of_budget = False  # stopped at max_motions: the rest of the program is not run
@@ -95,11 +103,13 @@ class Machine:
         # does, and a word for an axis the machine lacks is an error.  Printer
         # firmware reads F only on moves and U/V/W as flags (Prusa's G28 W).
         self.rs274_blocks = rs274_blocks
-        self.zero_feed = zero_feed  # an F at or below 0: "refused", "kept" (Marlin) or "minimum_speed" (RRF)
+        self.zero_feed = zero_feed  # an F at or below 0: "refused", "kept" (Marlin), "minimum_speed" (RRF), "stops"
         self.polar_incremental_only = polar_incremental_only  # GER's G16 rules
         self.state = MachineState()
         self.state.units = mm_per(initial_units)
         self.state.e_relative = initial_extrusion == "relative"
+        if zero_feed == "minimum_speed":
+            self.state.minimum_feed = minimum_feed
         self.state.cycle.retract_to_r = config.cycle_retract == "r"
         if config.initial_feed > 0:
             self.state.feed = config.initial_feed
@@ -315,6 +325,7 @@ class Machine:
             moving |= in_ids(t.name[rows], self._straight_ids)
         if not self.config.radius_arcs and "R" in t.params:
             self._reject_radius_arcs(t, rows, moving)
+        refused = self._refuse_invalid_speed(t, rows, moving) if self.zero_feed == "stops" else None
         motion = np.where(moving, t.motion[rows], 0).astype(np.uint8)
         scale = s.scale()
         program = s.program_position()
@@ -347,7 +358,9 @@ class Machine:
         feed_words[kind == Kind.COMMENT] = np.nan
         if not self.rs274_blocks:
             feed_words[kind == Kind.M] = np.nan
-        if self.zero_feed == "kept":
+        if refused is not None:
+            feed_words[refused] = np.nan  # the refused block sets no feed either
+        if self.zero_feed in ("kept", "stops"):
             self._ignore_feed_at_or_below_zero(t, rows, feed_words)
         if s.feed_mode == "inverse_time":
             feed = feed_words  # 1/min, for this block only
@@ -370,7 +383,8 @@ class Machine:
         if s.feed_mode == "per_rev":  # G95: F is mm per spindle revolution
             no_spindle = (feed > 0) & ((speed == 0) | (s.spindle == 0))
             feed = feed * np.abs(speed) * (s.spindle != 0)
-        time = self._durations(t, rows, kind, motion, distance, rotary, de, feed, no_spindle)
+        minimum = self._minimum_feeds(t, rows) if self.zero_feed == "minimum_speed" else None
+        time = self._durations(t, rows, kind, motion, distance, rotary, de, feed, no_spindle, minimum)
 
         for ax, letter in enumerate(AXES.lower()):
             out[letter][rows] = position[:, ax]
@@ -408,6 +422,32 @@ class Machine:
             self.diagnostics.report(int(t.line[rows][i]), 1, "this firmware rejects R-form arcs (give I/J); the arc is skipped",
                                     kind="machine")
         moving &= ~refused
+
+    def _refuse_invalid_speed(self, t: CommandTable, rows: slice, moving: np.ndarray) -> np.ndarray | None:
+        """Klipper refuses a G0-G3 with an F at or below 0: an error, and the block makes no move.
+
+        gcode_move.py ``cmd_G1`` reads the axis words into ``last_position``,
+        then raises "Invalid speed"; gcode.py's ``gcode:command_error`` event
+        makes ``reset_last_position`` take the toolhead's position back
+        (``toolhead.move`` never ran), so the words are dropped and the next
+        move starts where the tool is.  An arc (gcode_arcs.py) passes its F
+        to its first segment's ``cmd_G1``.  virtual_sdcard.py ``work_handler``
+        runs ``on_error_gcode`` and stops the print on the error; gcodekit
+        goes on in lenient mode, as for other firmware errors.  Returns the
+        refused rows (None if none).
+        """
+        if "F" not in t.params:
+            return None
+        refused = (_dense(t.params["F"], rows) <= 0) & in_ids(t.name[rows], _G0_TO_G3)
+        if not self.config.radius_arcs and "R" in t.params:  # an R-form arc is refused already
+            arc = in_ids(t.motion[rows], (MOTION_CW, MOTION_CCW))
+            refused &= ~(arc & ~np.isnan(_dense(t.params["R"], rows)))
+        if not refused.any():
+            return None
+        for i in np.flatnonzero(refused)[:20]:
+            self.diagnostics.report(int(t.line[rows][i]), 1, INVALID_SPEED, kind="machine")
+        moving &= ~refused
+        return refused
 
     def _extrusion(self, t: CommandTable, rows: slice, moving: np.ndarray) -> np.ndarray:
         s = self.state
@@ -508,10 +548,11 @@ class Machine:
                                     f"radius to end of arc differs from radius to start by {abs(r1[i] - r0[i]):.4g} mm",
                                     kind="machine")
 
-    def _durations(self, t, rows, kind, motion, distance, rotary, de, feed, no_spindle) -> np.ndarray:
+    def _durations(self, t, rows, kind, motion, distance, rotary, de, feed, no_spindle, minimum=None) -> np.ndarray:
         """Time of each row: length over feed (the planner refines this later).
 
-        ``no_spindle``: rows with a feed per revolution (G95) in force and the spindle stopped.
+        ``no_spindle``: rows with a feed per revolution (G95) in force and the spindle stopped;
+        ``minimum``: each row's minimum movement speed, mm/min (see :meth:`_minimum_feeds`), or None.
         """
         s = self.state
         n = kind.size
@@ -541,6 +582,10 @@ class Machine:
         else:
             rate = np.where(rapid, feed if self.rapid_is_feed else self.config.rapid_feed, feed)
             moving = feeding | rapid
+            if minimum is not None:
+                self._note_minimum_speed(t, rows, moving & (rate <= 0) & (path > 0), minimum)
+                # DDA::InitStandardMove: requestedSpeed = max(feedRate, MinMovementSpeed), then the axis caps
+                rate = np.maximum(rate, minimum)
             with np.errstate(divide="ignore", invalid="ignore"):
                 time[moving] = path[moving] / (rate[moving] / 60.0)
             bad = moving & ~(rate > 0) & (path > 0)
@@ -556,9 +601,6 @@ class Machine:
                 if no_spindle[first]:
                     self.warn_once("feed per rev", int(t.line[rows][first]), "feed per revolution (G95) with the "
                                    "spindle stopped: the move never ends (a controller stalls); its time is unknown")
-                elif self.zero_feed == "minimum_speed":
-                    self.warn_once("feed", int(t.line[rows][first]), "feed move at F0: this firmware takes F0 as "
-                                   "written and moves at its minimum movement speed (RepRapFirmware's M203 I)")
                 elif "feed" not in self._warned:
                     # no boot feed (GRBL's error 22, "undefined feed rate"; a Fanuc's feed-zero alarm)
                     self._warned.add("feed")
@@ -569,6 +611,30 @@ class Machine:
         if dwell.any():
             time[dwell] = self._dwell_times(t, rows, dwell)
         return time
+
+    def _minimum_feeds(self, t: CommandTable, rows: slice) -> np.ndarray:
+        """Each row's minimum movement speed, mm/min: RepRapFirmware's M203 I (GCodes2.cpp, case 203) held
+        from the machine's until the program gives one; 0 while not known."""
+        s = self.state
+        n = rows.stop - rows.start
+        if "I" not in t.params or not n:
+            return np.full(n, s.minimum_feed)
+        words = np.where(t.name[rows] == NAME_ID["set_max_feed"], _dense(t.params["I"], rows), np.nan)
+        held = forward_fill(words, s.minimum_feed)
+        s.minimum_feed = float(held[-1])
+        return held
+
+    def _note_minimum_speed(self, t, rows, crawling: np.ndarray, minimum: np.ndarray) -> None:
+        """Once: a feed move at F0 (or below), which RepRapFirmware takes as written (``GCodeBuffer::GetSpeed``
+        checks nothing) and moves at its minimum movement speed."""
+        if not crawling.any():
+            return
+        first = int(np.flatnonzero(crawling)[0])
+        speed = float(minimum[first])
+        known = f", {speed:g} mm/min here" if speed > 0 else (", which this machine does not give: its time is "
+                                                             "unknown")
+        self.warn_once("feed", int(t.line[rows][first]), "feed move at F0 (or below): this firmware takes it as "
+                       f"written and moves at its minimum movement speed (RepRapFirmware's M203 I){known}")
 
     def _ignore_feed_at_or_below_zero(self, t, rows, feed_words) -> None:
         """Firmware that sets its feed only from an F above 0: such F words go (said once)."""

@@ -108,10 +108,10 @@ class ModalHandler:
 
     def _read_feed(self, block: Block) -> None:
         """An F word sets the feed (in RS274NGC whatever else the block does; on firmware not beside an M code,
-        and on Marlin only above 0)."""
+        and on Marlin and Klipper only above 0)."""
         ctx, params = self.context, block.params
         if "F" in params and (block.letter != "M" or ctx.rs274_blocks):
-            if ctx.zero_feed == "kept" and not params["F"] > 0:
+            if ctx.zero_feed in ("kept", "stops") and not params["F"] > 0:  # Klipper's G28, G92 read no F
                 ctx.warn_once("feed at or below 0", block.line, FEED_AT_OR_BELOW_ZERO)
                 return
             # an F beside G20/G21 is in the block's new units ("G20 F60" is 60 in/min); where
@@ -137,7 +137,7 @@ class ModalHandler:
         """Feed of a move made by a special command, mm/min."""
         ctx = self.context
         feeding = motion in (MOTION_LINEAR, MOTION_CW, MOTION_CCW) or ctx.rapid_is_feed
-        return ctx.state.feed if feeding else ctx.config.rapid_feed
+        return max(ctx.state.feed, ctx.state.minimum_feed) if feeding else ctx.config.rapid_feed
 
     def _length(self, before: np.ndarray, point: np.ndarray, motion: int, centre) -> float:
         """Path length of a move made by a special command: the chord, or the arc round ``centre``."""

@@ -55,6 +55,7 @@ class MachineState:
     feed: float = np.nan  # mm/min, or 1/min in inverse-time mode
     feed_mode: str = "per_minute"  # "inverse_time" (G93), "per_rev" (G95)
     feed_given: bool = False  # an F word (or the first move, at the boot feed) came; see Machine._note_boot_feed
+    minimum_feed: float = 0.0  # mm/min, the slowest the firmware moves (RRF's M203 I); 0 if not known or none
     e_relative: bool = False  # M83
     e_program: float = 0.0  # E coordinate as the program sees it (mm)
     e_total: float = 0.0  # filament pushed so far (mm)

@@ -136,7 +136,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
         config = _stated_filament(program, config, diagnostics)
     bar = progress_bar(program, progress)
     try:
-        op, reading_error, machine_run = _emulated(program, fl, config, diagnostics, limits, bar)
+        op, reading_error, machine_run = _emulated(program, fl, config, diagnostics, limits, bar, machine_config)
         if uses_compensation(op):
             compensate(op, machine_run.tools, machine_run.comp_profile_ends)
         if mode == "strict":
@@ -214,7 +214,8 @@ def _with_slicer_limits(op: Operation, settings, chosen: bool):
     return dataclasses.replace(settings, **limits)
 
 
-def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits, bar):
+def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits, bar,
+              machine_config: str | os.PathLike | None = None):
     """Read, parse and emulate the program chunk by chunk into one Operation.
 
     Returns the operation, the reading error strict mode holds back (the
@@ -226,7 +227,7 @@ def _emulated(program: Program, fl: Flavor, config: MachineConfig, diagnostics: 
     parser = GcodeParser(fl, diagnostics)
     machine_diagnostics = Diagnostics(program.name, "lenient") if diagnostics.mode == "strict" else diagnostics
     machine_diagnostics.elsewhere = diagnostics.elsewhere
-    m = new_machine(fl, config, machine_diagnostics, limits)
+    m = new_machine(fl, config, machine_diagnostics, limits, machine_config)
     tables, waypoints, n_lines = TableJoiner(), WaypointJoiner(), 0
 
     def emulate(blocks: Blocks, lines: int) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from ..emulate.machine import Machine
@@ -11,6 +13,7 @@ from ..growing import GrowingColumn
 from ..limits import PLAUSIBLE_TIME_S, Limits
 from ..model.operation import Operation
 from ..parse import CommandTable, GcodeParser
+from ..plan import planner_settings
 from ..read import Blocks
 from ..syntax import Flavor
 from .program import Program, quote_diagnostics
@@ -18,12 +21,23 @@ from .program import Program, quote_diagnostics
 __all__ = ["new_machine", "empty_table", "WaypointJoiner", "raise_first_run", "warn_implausible_time"]
 
 
-def new_machine(flavor: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits = Limits()) -> Machine:
+def new_machine(flavor: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits = Limits(),
+                machine_config: str | os.PathLike | None = None) -> Machine:
     """The machine that runs a program of ``flavor`` (the flavor says how it reads blocks)."""
     return Machine(config, diagnostics, rapid_is_feed=flavor.rapid_is_feed, initial_units=flavor.units,
                    initial_extrusion=flavor.extrusion, rs274_blocks=flavor.block_split == "modal",
                    polar_incremental_only=flavor.polar_incremental_only, max_motions=limits.max_motions,
-                   zero_feed=flavor.zero_feed)
+                   zero_feed=flavor.zero_feed,
+                   minimum_feed=minimum_feed(config, machine_config) if flavor.zero_feed == "minimum_speed" else 0.0)
+
+
+def minimum_feed(config: MachineConfig, machine_config: str | os.PathLike | None = None) -> float:
+    """The slowest the machine's planner moves, mm/min (RepRapFirmware's ``minimum_movement_speed``, M203 I,
+    from the preset or the firmware's own config file); 0 when its planner has none."""
+    if not config.planner:
+        return 0.0
+    settings = planner_settings(config.planner, config.planner_settings, machine_config)
+    return float(getattr(settings, "minimum_movement_speed", 0.0))
 
 
 def empty_table(parser: GcodeParser, program: Program) -> CommandTable:

@@ -91,8 +91,9 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
     moves without a planned move (a move to where the tool already is) takes
     none, and one that does not move (a dwell) keeps its own.  A feed move
     with no feed rate in force gets NaN: its time is unknown, not the
-    planner's crawl at its minimum speed; so does a move planned at no
-    speed (an infinite time).
+    planner's crawl at its minimum speed, unless the emulator timed it too
+    (RepRapFirmware takes F0 as written and does crawl at M203 I); a move
+    planned at no speed (an infinite time) gets NaN as well.
     """
     n = w["x"].size
     times = np.zeros(n)
@@ -105,9 +106,12 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
     has_moves[moves.waypoint] = True
     idle = np.flatnonzero(~has_moves)
     times[idle] = np.where(np.asarray(w["motion"])[idle] > 0, 0.0, np.asarray(w["time"])[idle])
-    # a feed move with no feed in force has no time a planner could know (its minimum speed is no answer),
-    # nor has a move a planner gave no speed at all (a printer's G0 at F0): unknown, as the emulator has it
+    # a feed move with no feed in force has no time a planner could know (its minimum speed is no answer)
+    # where the emulator knew none either; nor has a move a planner gave no speed at all (a printer's G0 at
+    # F0): unknown, as the emulator has it.  The emulator times F0 where the firmware moves at a minimum
+    # speed it knows (RepRapFirmware's M203 I), and then the planner's crawl is the firmware's.
     unknown = (np.asarray(w["motion"]) >= 2) & ~(np.asarray(w["feed"], float) > 0) & (np.asarray(w["distance"]) > 0)
+    unknown &= ~np.isfinite(np.asarray(w["time"], float))
     times[unknown] = np.nan
     times[np.isinf(times)] = np.nan
     return times

@@ -19,7 +19,7 @@ from typing import Mapping
 #: ``sequential``: GER, every G/M code starts a new statement in text order.
 BLOCK_SPLITS = ("modal", "single", "sequential")
 #: What firmware does with an F at or below 0 (see :attr:`Flavor.zero_feed`).
-ZERO_FEEDS = ("refused", "kept", "minimum_speed")
+ZERO_FEEDS = ("refused", "kept", "minimum_speed", "stops")
 
 #: Normalized command names a flavor's ``[codes]`` table may map to.
 COMMANDS = frozenset(
@@ -202,14 +202,15 @@ class Flavor:
         E mode at program start; ``""`` when the dialect does not extrude.
     rapid_is_feed : bool
         G0 moves at the programmed feed (Marlin), not at the rapid rate.
-    zero_feed : {"refused", "kept", "minimum_speed"}
+    zero_feed : {"refused", "kept", "minimum_speed", "stops"}
         What the firmware does with an F at or below 0: ``"refused"``, its
         feed moves are refused (GRBL's error 22, LinuxCNC, a Fanuc's
         alarm); ``"kept"``, the F is ignored and the feed rate stays (Marlin
-        and Prusa's firmware set it only from an F above 0; Klipper refuses
-        the command, "Invalid speed"); ``"minimum_speed"``, the F is taken
-        and the moves crawl at the minimum movement speed (RepRapFirmware's
-        M203 I).
+        and Prusa's firmware set it only from an F above 0);
+        ``"minimum_speed"``, the F is taken and the moves crawl at the
+        minimum movement speed (RepRapFirmware's M203 I); ``"stops"``, a
+        G0-G3 carrying it is an error that makes no move, and a print from
+        the SD card stops there (Klipper's "Invalid speed").
     initial_motion : {"", "rapid", "linear"}
         Motion mode in force at program start (GER starts in G0), so axis
         words alone move; ``""`` when they need a motion code first.

@@ -8,7 +8,8 @@ from __future__ import annotations
 from ...units import MM_PER_INCH
 from .registry import Block, Context, handles
 
-#: Said once where firmware that sets its feed only from an F above 0 (Marlin) meets F0 or below.
+#: Said once where firmware that sets its feed only from an F above 0 (Marlin; Klipper outside G0-G3) meets
+#: F0 or below.
 FEED_AT_OR_BELOW_ZERO = "F at or below 0 sets no feed rate on this firmware: it keeps the one it had"
 #: mm per program unit after G20 / G21
 UNITS = {"units_inch": MM_PER_INCH, "units_mm": 1.0}
