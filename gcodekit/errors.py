@@ -115,7 +115,9 @@ class Diagnostics:
         self.limit = limit
         self.repeats = repeats
         self.items: list[Diagnostic] = []
-        self._kinds: list[str] = []  # of each item: which GcodeError it raises as
+        # of each item: which GcodeError it raises as (_ERROR_TYPES), or for an info what it notes
+        # ("unknown_code": a code the flavor gives no meaning)
+        self._kinds: list[str] = []
         self.dropped = 0  # not listed: beyond the limit, or repeats counted in a summary
         self._seen: dict[tuple[str, str], int] = {}  # (severity, message) -> times reported
         self._summary_at: dict[tuple[str, str], int] = {}  # -> index of its summary in items
@@ -173,6 +175,16 @@ class Diagnostics:
         self.items[at] = Diagnostic(first.file, first.line, first.column, first.severity,
                                     f"{key[1]} -- and {more} more times from this line on, not listed", first.text)
 
+    def report_first(self, line: int, column: int, message: str, text: str = "", *,
+                     severity: Literal["warning", "info"] = "warning") -> Diagnostic:
+        """Record a diagnostic ahead of those recorded so far, past :attr:`limit` too: a note that explains
+        them (the dialect a program looks written in) is read before them."""
+        diag = Diagnostic(self.file, int(line), int(column), severity, message, text)
+        self.items.insert(0, diag)
+        self._kinds.insert(0, "syntax")
+        self._summary_at = {key: at + 1 for key, at in self._summary_at.items()}
+        return diag
+
     def warn(self, line: int, column: int, message: str, text: str = "") -> Diagnostic:
         return self.report(line, column, message, text, severity="warning")
 
@@ -200,6 +212,12 @@ class Diagnostics:
         """The errors of a limit reached (``max_motions``, ``max_iterations``, ...): the run stopped short
         of the program's end, or planned part of it coarser (see :mod:`gcodekit.limits`)."""
         return [d for d, kind in zip(self.items, self._kinds) if kind == "limit" and d.severity == "error"]
+
+    @property
+    def unknown_codes(self) -> list[Diagnostic]:
+        """The infos on codes the flavor gives no meaning, one per code (infos, since firmware add codes
+        freely; a program in another dialect makes them too)."""
+        return [d for d, kind in zip(self.items, self._kinds) if kind == "unknown_code"]
 
     @property
     def errors(self) -> list[Diagnostic]:

@@ -418,3 +418,102 @@ def test_stated_filament_diameter_gives_the_volume(tmp_path):
     assert op.summary()["volume_mm3"] == pytest.approx(np.pi * 2.85**2 / 4)
     given = gcodekit.gcode_to_operation(text, flavor="marlin", plan=False, filament_diameter=1.75)
     assert given.machine.filament_diameter == 1.75 and not given.diagnostics.items
+
+
+LOOKS = "the program looks written for"
+
+
+def _hints(op) -> list:
+    return [d for d in op.diagnostics.items if d.message.startswith(LOOKS)]
+
+
+def test_printer_program_read_as_a_mill_dialect_says_which_dialect_it_looks_written_for(realworld):
+    op = gcodekit.gcode_to_operation(realworld / "kisslicer_1.1.0.14_cube.gcode", flavor="rs274ngc", plan=False)
+    hints = _hints(op)
+    # one warning, first, at 1:1, beside the 109 true rs274ngc diagnostics it explains (31 of them errors;
+    # 78 are repeats of listed messages, counted in their summaries)
+    assert len(hints) == 1 and op.diagnostics.items[0] is hints[0]
+    assert (hints[0].severity, hints[0].line, hints[0].column) == ("warning", 1, 1)
+    assert op.summary()["diagnostics_total"] == 110 and len(op.diagnostics.errors) == 31
+    assert hints[0].message == (
+        r"the program looks written for 'marlin' (header matches /(?m)^;\s*KISSlicer\b/), but was read as "
+        "'rs274ngc' (the flavor given): the errors may come from that; to read it as 'marlin', give --flavor marlin "
+        "(flavor='marlin')")
+    assert hints[0].text == "; KISSlicer - FREE"  # line 1, quoted like any diagnostic's
+    # the flavor came with the machine: the advice is a machine for the dialect
+    on_mill = _hints(gcodekit.gcode_to_operation(realworld / "kisslicer_1.1.0.14_cube.gcode", machine="linuxcnc",
+                                                 plan=False))
+    assert len(on_mill) == 1 and "(the linuxcnc machine's flavor)" in on_mill[0].message
+    assert on_mill[0].message.endswith("give a machine for it, e.g. --machine marlin (machine='marlin')")
+
+
+def test_printer_program_read_as_grbl_says_so_for_the_codes_grbl_does_not_know(realworld):
+    # no error or warning here: GRBL keeps M104, M109, ... as codes without meaning (an info each)
+    op = gcodekit.gcode_to_operation(realworld / "kisslicer_1.1.0.14_cube.gcode", flavor="grbl", plan=False)
+    assert not op.diagnostics.errors and len(op.diagnostics.unknown_codes) == 7
+    hints = _hints(op)
+    assert len(hints) == 1 and "but was read as 'grbl' (the flavor given): the codes unknown to 'grbl' may" \
+        in hints[0].message
+    assert hints[0].severity == "info"  # as what it explains
+
+
+@pytest.mark.parametrize("name, flavor", [
+    ("kisslicer_1.1.0.14_cube.gcode", "marlin"), ("kisslicer_1.1.0.14_cube.gcode", "prusa"),
+    ("kisslicer_1.1.0.14_cube.gcode", "klipper"), ("cura_legacy_fabtotum_cable_ties.gcode", "klipper"),
+    # Marlin-family files read as a relative: no hint, though Marlin cannot read Klipper's START_PRINT or
+    # MakerBot's parenthesised comments and Prusa's firmware has no Bambu M620 (one family shares its syntax)
+    ("orca_2.3.0b2_k1max_klipper.gcode", "marlin"), ("cura_5.9.1_k1max.gcode", "marlin"),
+    ("miraclegrue_0.04_20mm_box.gcode", "marlin"), ("bambustudio_1.7.6_x1_cube.gcode", "prusa"),
+])
+def test_no_hint_for_the_program_s_own_dialect_or_a_relative(realworld, name, flavor):
+    op = gcodekit.gcode_to_operation(realworld / name, flavor=flavor, plan=False)
+    something_to_explain = op.diagnostics.errors or op.diagnostics.unknown_codes or any(
+        d.severity == "warning" for d in op.diagnostics.items)
+    assert something_to_explain and _hints(op) == []
+
+
+def test_linuxcnc_program_read_as_marlin_hints_only_on_strong_evidence(shared_dir):
+    nc_files = shared_dir / "corpus" / "linuxcnc" / "nc_files"
+    # g20sub.ngc opens with 'O<g20sub> sub': LinuxCNC's own syntax, which Marlin reads as 19 errors
+    op = gcodekit.gcode_to_operation(nc_files / "g20sub.ngc", flavor="marlin", plan=False)
+    hints = _hints(op)
+    assert len(hints) == 1 and len(op.diagnostics.errors) == 19
+    assert hints[0].message.startswith(r"the program looks written for 'rs274ngc' (header matches /(?im)^\s*o(")
+    assert hints[0].message.endswith("give --flavor rs274ngc (flavor='rs274ngc')")
+    # 3dtest.ngc has 22 errors as Marlin, but only its .ngc name points to LinuxCNC: too little to say
+    thin = gcodekit.gcode_to_operation(nc_files / "3dtest.ngc", flavor="marlin", plan=False)
+    assert len(thin.diagnostics.errors) == 22 and _hints(thin) == []
+    assert not detect_flavor((nc_files / "3dtest.ngc").read_text(), "3dtest.ngc").decides_family
+
+
+def test_dialect_hint_needs_evidence_and_something_to_explain():
+    # a Cura banner and an E word: strong evidence, and rs274ngc's two errors to explain
+    op = gcodekit.gcode_to_operation(";FLAVOR:Marlin\nM104 S200\nG1 X1 E1 F600\n", flavor="rs274ngc", plan=False)
+    assert [d.line for d in _hints(op)] == [1] and len(op.diagnostics.errors) == 2
+    # the same errors without the banner: a guess, not evidence (the detection scores nothing)
+    bare = gcodekit.gcode_to_operation("M104 S200\nG1 X1 E1 F600\n", flavor="rs274ngc", plan=False)
+    assert len(bare.diagnostics.errors) == 2 and _hints(bare) == []
+    # the banner on a program rs274ngc reads without a complaint: nothing to explain
+    clean = gcodekit.gcode_to_operation(";FLAVOR:Marlin\nG21\nG1 X1 F600\nM2\n", flavor="rs274ngc", plan=False)
+    assert clean.diagnostics.items == []
+    # detected, not given: the reading is the detection's, nothing to add
+    detected = gcodekit.gcode_to_operation(";FLAVOR:Marlin\nM104 S200\nG1 X1 E1 F600\n", plan=False)
+    assert detected.flavor.name == "marlin" and _hints(detected) == []
+
+
+def test_dialect_hint_when_parsing_only():
+    op = gcodekit.parse_program(";FLAVOR:Marlin\nM104 S200\nG1 X1 E1 F600\n", flavor="fanuc")
+    assert len(_hints(op)) == 1 and "but was read as 'fanuc'" in _hints(op)[0].message
+
+
+def test_a_note_put_first_leaves_the_summaries_counting():
+    from gcodekit.errors import Diagnostics
+
+    diagnostics = Diagnostics("part.ngc", repeats=2)
+    for line in (1, 2, 3):
+        diagnostics.report(line, 1, "bad")
+    note = diagnostics.report_first(1, 1, "explains them")
+    diagnostics.report(4, 1, "bad")  # counted into the summary, which moved one place down
+    assert [d.message for d in diagnostics.items] == [
+        "explains them", "bad", "bad", "bad -- and 2 more times from this line on, not listed"]
+    assert diagnostics.items[0] is note and note.severity == "warning" and diagnostics.dropped == 2

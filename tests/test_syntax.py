@@ -135,6 +135,18 @@ def test_inheritance_from_sibling_and_cycles(tmp_path):
         load_flavor(tmp_path / "a.toml")
 
 
+def test_lineage_and_family_follow_inherit(tmp_path):
+    assert load_flavor("klipper").lineage == ("marlin",) and load_flavor("bambu").family == "marlin"
+    assert load_flavor("grbl_laser").family == "grbl"
+    assert load_flavor("rs274ngc").lineage == () and load_flavor("rs274ngc").family == "rs274ngc"
+    _write(tmp_path, 'name = "base"\n', "base")
+    _write(tmp_path, 'name = "child"\ninherit = "base"\n', "child")
+    grandchild = load_flavor(_write(tmp_path, 'name = "grandchild"\ninherit = "child"\n', "grandchild"))
+    assert grandchild.lineage == ("child", "base") and grandchild.family == "base"
+    with pytest.raises(ConfigError, match="lineage: unknown key"):  # the loader's to set, not a file's
+        load_flavor(_write(tmp_path, 'name = "bad"\nlineage = ["marlin"]\n'))
+
+
 def _head(path: Path) -> str:
     with path.open(errors="replace") as fh:
         return fh.read(HEAD_CHARS)
@@ -181,6 +193,24 @@ def test_detect_tie_lists_candidates():
     assert detection.name == "marlin"
     assert detection.candidates[1] == ("klipper", detection.score)
     assert any("close candidates" in r and "priority" in r for r in detection.reasons)
+
+
+def test_detect_decides_the_family_and_names_its_evidence():
+    # Cura's ';FLAVOR:Marlin' beside Klipper's START_PRINT: klipper (15) by a point over marlin (14), on other
+    # headers, so the choice is weak -- but both are Marlin's family
+    both = detect_flavor(";FLAVOR:Marlin\nSTART_PRINT\nM82\nG1 X1 E0.5\n")
+    assert (both.name, both.score, both.weak, both.decides_family) == ("klipper", 15.0, True, True)
+    assert both.evidence == ("header matches /(?im)^[ \\t]*(PRINT_START|START_PRINT|SET_PRESSURE_ADVANCE|"
+                             "SET_VELOCITY_LIMIT|EXCLUDE_OBJECT_DEFINE|EXCLUDE_OBJECT_START|BED_MESH_PROFILE|"
+                             "SET_RETRACTION)\\b/",)
+    # a Marlin banner (11) and LinuxCNC's o<x> sub (10): a point apart, of two families
+    mixed = detect_flavor(";FLAVOR:Marlin\no<x> sub\nG1 X1\no<x> endsub\n")
+    assert (mixed.name, mixed.score, dict(mixed.candidates)["rs274ngc"]) == ("marlin", 11.0, 10.0)
+    assert not mixed.decides_family
+    # no header: 3 points (E words, M104), too few; the evidence is then every reason
+    thin = detect_flavor("G1 X1 E0.5\nM104 S200\n")
+    assert thin.score == 3.0 and not thin.decides_family
+    assert thin.evidence == ("E words on moves", "typical codes M104")
 
 
 def test_detect_ger_sample():

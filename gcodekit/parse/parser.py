@@ -457,7 +457,8 @@ class GcodeParser:
                                       "kept as a generic command")
             else:  # firmware add codes freely (M900, M620, ...): say once, quietly, that it does nothing here
                 self.diagnostics.report(line, 1, f"{code} has no meaning in gcodekit's {self.flavor.name} flavor; "
-                                        "kept as a command without effect on the path", severity="info")
+                                        "kept as a command without effect on the path", severity="info",
+                                        kind="unknown_code")
 
 
 def _by_name(pairs) -> np.ndarray:

@@ -39,7 +39,8 @@ from ..plan import planner_settings, run_planner
 from ..read import Blocks
 from ..syntax import Flavor
 from .assemble import WaypointJoiner, empty_table, new_machine, raise_first_run, warn_implausible_time
-from .program import Program, as_program, check_program_end, note_weak_detection, progress_bar, quote_diagnostics, resolve
+from .program import (Program, as_program, check_program_end, note_other_dialect, note_weak_detection, progress_bar,
+                      quote_diagnostics, resolve)
 from .source import program_blocks, restore_line_numbers
 
 if TYPE_CHECKING:
@@ -63,6 +64,8 @@ def parse_program(source: str | os.PathLike, flavor: str | Flavor | None = None,
     for blocks, lines in program_blocks(program, fl, diagnostics):
         joiner.add(parser.parse(blocks))
         n_lines += lines
+    if detection is None:
+        note_other_dialect(program, fl, diagnostics)
     cls = OPERATION_CLASSES[config.process]
     table = joiner.finish()
     if table is None:
@@ -143,6 +146,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
             raise_first_run(op, program, reading_error)
             diagnostics.extend(op.diagnostics)  # its warnings
             op.diagnostics = diagnostics
+        if detection is None:  # the flavor was given, or came with the machine
+            note_other_dialect(program, fl, op.diagnostics, machine=None if flavor is not None else config.name)
         if plan and config.planner:
             settings = planner_settings(config.planner, config.planner_settings, machine_config)
             if config.planner == "marlin" and machine_config is None:

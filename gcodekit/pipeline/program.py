@@ -22,8 +22,8 @@ from ..parse.table import NAME_ID
 from ..read import iter_lines
 from ..syntax import Detection, Flavor, detect_flavor, load_flavor
 
-__all__ = ["Program", "as_program", "resolve", "note_weak_detection", "check_program_end", "quote_diagnostics",
-           "progress_bar"]
+__all__ = ["Program", "as_program", "resolve", "note_weak_detection", "note_other_dialect", "check_program_end",
+           "quote_diagnostics", "progress_bar"]
 
 _PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
 
@@ -108,6 +108,43 @@ def note_weak_detection(detection: Detection | None, diagnostics: Diagnostics) -
     if detection is not None and detection.weak:
         diagnostics.report(1, 1, f"flavor {detection.name!r} chosen on thin evidence ({'; '.join(detection.reasons)}); "
                            "give the flavor (flavor=, --flavor) if the program is in another dialect", severity="info")
+
+
+def note_other_dialect(program: Program, flavor: Flavor, diagnostics: Diagnostics, *,
+                       machine: str | None = None) -> None:
+    """A note, ahead of the others, when a program read as a given flavor plainly is in another dialect.
+
+    Said only when it explains something and is true: the reading gave
+    errors, warnings or codes the flavor gives no meaning, the program's
+    head names another dialect strongly (a header's worth of evidence, and
+    no candidate close of another family: :attr:`Detection.decides_family`)
+    and that dialect is of another family than the flavor read (Marlin,
+    Prusa, Klipper and Bambu are one: they share syntax and base codes).
+    It is a warning, or an info when it explains only infos (codes without
+    meaning, which firmware add freely).  Detection reads the head only, and
+    only for a program with such diagnostics.  ``machine`` names the preset
+    the flavor came with, when the caller gave a machine and no flavor.
+    """
+    if diagnostics.has_error:
+        found, severity = "the errors", "warning"
+    elif any(d.severity == "warning" for d in diagnostics.items):
+        found, severity = "the warnings", "warning"
+    elif diagnostics.unknown_codes:  # infos, so an info too
+        found, severity = f"the codes unknown to {flavor.name!r}", "info"
+    else:
+        return
+    detection = detect_flavor(program.head(), program.name if program.path else None)
+    if not detection.decides_family or load_flavor(detection.name).family == flavor.family:
+        return
+    name = detection.name
+    if machine:
+        read_as = f"the {machine} machine's flavor"
+        advice = f"a machine for it, e.g. --machine {default_machine_for(name)} (machine={default_machine_for(name)!r})"
+    else:
+        read_as, advice = "the flavor given", f"--flavor {name} (flavor={name!r})"
+    diagnostics.report_first(1, 1, f"the program looks written for {name!r} ({'; '.join(detection.evidence)}), but "
+                             f"was read as {flavor.name!r} ({read_as}): {found} may come from that; to read it "
+                             f"as {name!r}, give {advice}", severity=severity)
 
 
 def check_program_end(program: Program, table: CommandTable, n_lines: int, diagnostics: Diagnostics) -> None:

@@ -82,6 +82,24 @@ class Detection:
     candidates: tuple[tuple[str, float], ...]
     weak: bool = False
 
+    @property
+    def decides_family(self) -> bool:
+        """The evidence decides the dialect's family: a header's worth of points (:data:`STRONG_SCORE`),
+        and every candidate within :data:`CLOSE_POINTS` of the winner is of its family (a Cura banner
+        ``;FLAVOR:Marlin`` beside Klipper's ``START_PRINT`` leaves no doubt of a Marlin-family program)."""
+        if self.score < STRONG_SCORE:
+            return False
+        family = load_flavor(self.name).family
+        return all(load_flavor(name).family == family
+                   for name, score in self.candidates if score >= self.score - CLOSE_POINTS)
+
+    @property
+    def evidence(self) -> tuple[str, ...]:
+        """The reasons that carry the choice: the header matches (a slicer banner, a dialect-only
+        command), else every reason but the close candidates."""
+        headers = tuple(r for r in self.reasons if r.startswith("header"))
+        return headers or tuple(r for r in self.reasons if not r.startswith("close candidates"))
+
 
 @dataclass(frozen=True)
 class _Rules:

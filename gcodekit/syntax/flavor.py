@@ -219,6 +219,10 @@ class Flavor:
     feature_comment : str
         Regular expression whose first group names the feature being made.
     detect : DetectRules
+    lineage : tuple of str
+        The flavors this one inherits from, nearest first (klipper:
+        ``("marlin",)``); the loader sets it from ``inherit``, no file
+        writes it.
     """
 
     name: str
@@ -258,6 +262,13 @@ class Flavor:
     layer_comments: tuple[str, ...] = ()
     feature_comment: str = ""
     detect: DetectRules = DetectRules()
+    lineage: tuple[str, ...] = ()
+
+    @property
+    def family(self) -> str:
+        """The flavor at the root of its inheritance (prusa, klipper, bambu: ``"marlin"``); one family's
+        dialects share their syntax and base codes."""
+        return self.lineage[-1] if self.lineage else self.name
 
     def command(self, code: str) -> str | None:
         """Normalized command name of a code such as ``"G1"``, or None."""

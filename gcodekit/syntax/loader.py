@@ -6,7 +6,8 @@ naming the file, the table and the key, with a did-you-mean when a close
 spelling exists.  A file may start from another with ``inherit = "name"``:
 scalars and lists replace the parent's, the ``[words]``, ``[codes]``,
 ``[firmware_codes]`` and ``[detect]`` tables merge key by key, and a word or
-code mapped to ``""`` is removed.
+code mapped to ``""`` is removed; the chain of parents is kept as the
+flavor's ``lineage``.
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ FLAVOR_DIR = Path(__file__).with_name("flavors")
 _TABLES = ("words", "codes", "firmware_codes", "detect")
 #: Keys that are not Flavor fields.
 _EXTRA_KEYS = ("inherit",)
+#: Flavor fields the loader sets, not the file.
+_LOADER_FIELDS = ("lineage",)
 #: Codes are written as in the program but normalized: upper case, no
 #: leading zeros (``G1``, ``G38.2``, ``M104``); extended commands are names.
 _GM_CODE = re.compile(r"[GM](?:0|[1-9]\d*)(?:\.\d+)?")
@@ -63,7 +66,8 @@ def _schema(cls: type) -> dict[str, str]:
     return out
 
 
-_FLAVOR_KEYS = _schema(Flavor) | dict.fromkeys(_EXTRA_KEYS, "str")
+_FLAVOR_KEYS = ({k: v for k, v in _schema(Flavor).items() if k not in _LOADER_FIELDS}
+                | dict.fromkeys(_EXTRA_KEYS, "str"))
 _DEFAULTS = {f.name: f.default for f in fields(Flavor)}
 _DETECT_KEYS = _schema(DetectRules)
 
@@ -158,11 +162,13 @@ def _resolve(path: Path, seen: tuple[Path, ...]) -> dict[str, Any]:
             f"{path}: inherit: unknown flavor {parent_name!r}{did_you_mean(parent_name, names)}"
         )
     merged = _resolve(parent_path.resolve(), (*seen, path))
+    lineage = (parent_name, *merged.get("lineage", ()))
     for key, value in raw.items():
         if key in _TABLES:
             merged[key] = {**merged.get(key, {}), **value}
         else:
             merged[key] = value
+    merged["lineage"] = lineage
     return merged
 
 
@@ -309,4 +315,5 @@ def _build(data: dict[str, Any], path: Path) -> Flavor:
         codes=MappingProxyType(codes),
         firmware_codes=MappingProxyType(firmware_codes),
         detect=DetectRules(**rules),
+        lineage=data.get("lineage", ()),
     )
