@@ -135,14 +135,13 @@ def test_inheritance_from_sibling_and_cycles(tmp_path):
         load_flavor(tmp_path / "a.toml")
 
 
-def test_lineage_and_family_follow_inherit(tmp_path):
-    assert load_flavor("klipper").lineage == ("marlin",) and load_flavor("bambu").family == "marlin"
-    assert load_flavor("grbl_laser").family == "grbl"
-    assert load_flavor("rs274ngc").lineage == () and load_flavor("rs274ngc").family == "rs274ngc"
+def test_lineage_follows_inherit(tmp_path):
+    assert load_flavor("klipper").lineage == ("marlin",) and load_flavor("bambu").lineage[-1] == "marlin"
+    assert load_flavor("grbl_laser").lineage == ("grbl",) and load_flavor("rs274ngc").lineage == ()
     _write(tmp_path, 'name = "base"\n', "base")
     _write(tmp_path, 'name = "child"\ninherit = "base"\n', "child")
     grandchild = load_flavor(_write(tmp_path, 'name = "grandchild"\ninherit = "child"\n', "grandchild"))
-    assert grandchild.lineage == ("child", "base") and grandchild.family == "base"
+    assert grandchild.lineage == ("child", "base")
     with pytest.raises(ConfigError, match="lineage: unknown key"):  # the loader's to set, not a file's
         load_flavor(_write(tmp_path, 'name = "bad"\nlineage = ["marlin"]\n'))
 
@@ -195,21 +194,25 @@ def test_detect_tie_lists_candidates():
     assert any("close candidates" in r and "priority" in r for r in detection.reasons)
 
 
-def test_detect_decides_the_family_and_names_its_evidence():
+def test_detect_rules_out_the_dialects_that_cannot_read_the_program_and_names_its_evidence():
     # Cura's ';FLAVOR:Marlin' beside Klipper's START_PRINT: klipper (15) by a point over marlin (14), on other
-    # headers, so the choice is weak -- but both are Marlin's family
+    # headers, so the choice is weak: neither is ruled out, nor Prusa, which reads Marlin's programs;
+    # LinuxCNC and GRBL are
     both = detect_flavor(";FLAVOR:Marlin\nSTART_PRINT\nM82\nG1 X1 E0.5\n")
-    assert (both.name, both.score, both.weak, both.decides_family) == ("klipper", 15.0, True, True)
+    assert (both.name, both.score, both.weak) == ("klipper", 15.0, True)
+    assert [both.rules_out(load_flavor(f)) for f in ("klipper", "marlin", "prusa", "rs274ngc", "grbl")] == [
+        False, False, False, True, True]
     assert both.evidence == ("header matches /(?im)^[ \\t]*(PRINT_START|START_PRINT|SET_PRESSURE_ADVANCE|"
                              "SET_VELOCITY_LIMIT|EXCLUDE_OBJECT_DEFINE|EXCLUDE_OBJECT_START|BED_MESH_PROFILE|"
                              "SET_RETRACTION)\\b/",)
     # a Marlin banner (11) and LinuxCNC's o<x> sub (10): a point apart, of two families
     mixed = detect_flavor(";FLAVOR:Marlin\no<x> sub\nG1 X1\no<x> endsub\n")
     assert (mixed.name, mixed.score, dict(mixed.candidates)["rs274ngc"]) == ("marlin", 11.0, 10.0)
-    assert not mixed.decides_family
+    assert not mixed.rules_out(load_flavor("rs274ngc")) and not mixed.rules_out(load_flavor("marlin"))
+    assert mixed.rules_out(load_flavor("grbl"))  # it reads neither
     # no header: 3 points (E words, M104), too few; the evidence is then every reason
     thin = detect_flavor("G1 X1 E0.5\nM104 S200\n")
-    assert thin.score == 3.0 and not thin.decides_family
+    assert thin.score == 3.0 and not thin.rules_out(load_flavor("rs274ngc"))
     assert thin.evidence == ("E words on moves", "typical codes M104")
 
 

@@ -115,12 +115,12 @@ def note_other_dialect(program: Program, flavor: Flavor, diagnostics: Diagnostic
     """A note, ahead of the others, when a program read as a given flavor plainly is in another dialect.
 
     Said only when it explains something and is true: the reading gave
-    errors, warnings or codes the flavor gives no meaning, the program's
-    head names another dialect strongly (a header's worth of evidence, and
-    no candidate close of another family: :attr:`Detection.decides_family`)
-    and that dialect is of another family than the flavor read (Marlin,
-    Prusa, Klipper and Bambu are one: they share syntax and base codes).
-    It is a warning, or an info when it explains only infos (codes without
+    errors, warnings or codes the flavor gives no meaning, and the
+    program's head names strongly a dialect the flavor cannot read (not
+    the flavor itself nor one it inherits from, and no close candidate
+    that is: :meth:`Detection.rules_out`; a Marlin program read as Klipper
+    gets none, a Klipper program read as Marlin does, but between dialects
+    of one family only when the reading gave errors).  It is a warning, or an info when it explains only infos (codes without
     meaning, which firmware add freely).  Detection reads the head only, and
     only for a program with such diagnostics.  ``machine`` names the preset
     the flavor came with, when the caller gave a machine and no flavor.
@@ -134,8 +134,10 @@ def note_other_dialect(program: Program, flavor: Flavor, diagnostics: Diagnostic
     else:
         return
     detection = detect_flavor(program.head(), program.name if program.path else None)
-    if not detection.decides_family or load_flavor(detection.name).family == flavor.family:
+    if not detection.rules_out(flavor):
         return
+    if load_flavor(detection.name).family == flavor.family and not diagnostics.has_error:
+        return  # a relative's codes it lacks (Prusa's M862 on Marlin) are only noted: the choice may be the user's
     name = detection.name
     if machine:
         read_as = f"the {machine} machine's flavor"

@@ -82,16 +82,15 @@ class Detection:
     candidates: tuple[tuple[str, float], ...]
     weak: bool = False
 
-    @property
-    def decides_family(self) -> bool:
-        """The evidence decides the dialect's family: a header's worth of points (:data:`STRONG_SCORE`),
-        and every candidate within :data:`CLOSE_POINTS` of the winner is of its family (a Cura banner
-        ``;FLAVOR:Marlin`` beside Klipper's ``START_PRINT`` leaves no doubt of a Marlin-family program)."""
+    def rules_out(self, flavor: Flavor) -> bool:
+        """The evidence names a dialect ``flavor`` cannot read: a header's worth of points
+        (:data:`STRONG_SCORE`) for a flavor that is neither ``flavor`` nor one it inherits from (Klipper
+        reads Marlin's programs, Marlin not Klipper's), and no candidate within :data:`CLOSE_POINTS` of it
+        that is (Cura's ``;FLAVOR:Marlin`` beside Klipper's ``START_PRINT`` does not rule Marlin out)."""
         if self.score < STRONG_SCORE:
             return False
-        family = load_flavor(self.name).family
-        return all(load_flavor(name).family == family
-                   for name, score in self.candidates if score >= self.score - CLOSE_POINTS)
+        readable = {flavor.name, *flavor.lineage}
+        return all(name not in readable for name, score in self.candidates if score >= self.score - CLOSE_POINTS)
 
     @property
     def evidence(self) -> tuple[str, ...]:

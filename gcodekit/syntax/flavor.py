@@ -266,7 +266,7 @@ class Flavor:
 
     @property
     def family(self) -> str:
-        """The flavor at the root of its inheritance (prusa, klipper, bambu: ``"marlin"``); one family's
+        """The flavor at the root of its inheritance (prusa, klipper, bambu: ``"marlin"``): one family's
         dialects share their syntax and base codes."""
         return self.lineage[-1] if self.lineage else self.name
 
