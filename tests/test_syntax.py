@@ -202,9 +202,7 @@ def test_detect_rules_out_the_dialects_that_cannot_read_the_program_and_names_it
     assert (both.name, both.score, both.weak) == ("klipper", 15.0, True)
     assert [both.rules_out(load_flavor(f)) for f in ("klipper", "marlin", "prusa", "rs274ngc", "grbl")] == [
         False, False, False, True, True]
-    assert both.evidence == ("header matches /(?im)^[ \\t]*(PRINT_START|START_PRINT|SET_PRESSURE_ADVANCE|"
-                             "SET_VELOCITY_LIMIT|EXCLUDE_OBJECT_DEFINE|EXCLUDE_OBJECT_START|BED_MESH_PROFILE|"
-                             "SET_RETRACTION)\\b/",)
+    assert both.evidence == ("header 'START_PRINT' on line 2",)
     # a Marlin banner (11) and LinuxCNC's o<x> sub (10): a point apart, of two families
     mixed = detect_flavor(";FLAVOR:Marlin\no<x> sub\nG1 X1\no<x> endsub\n")
     assert (mixed.name, mixed.score, dict(mixed.candidates)["rs274ngc"]) == ("marlin", 11.0, 10.0)

@@ -36,6 +36,8 @@ HINT_POINTS = 3.0
 E_WORD_POINTS = 2.0
 CODE_POINTS = 1.0
 COMMENT_POINTS = 1.0
+#: A header's line is quoted in the reasons up to this many characters.
+_SHOWN_CHARS = 60
 #: Below this best score the evidence is too thin and a default is used.
 MIN_SCORE = 3.0
 #: Below this best score (less than a header or a unique extension) the choice is weak.
@@ -162,15 +164,24 @@ class _Evidence:
     suffix: str
     e_words: bool = False  # E words on moves (see _e_words_on_moves)
     moves: int = 0  # move lines in the head (see _MOVE_LINE)
-    found: dict[tuple[str, bool], bool] = field(default_factory=dict, compare=False)
+    found: dict[tuple[str, bool], re.Match[str] | None] = field(default_factory=dict, compare=False)
 
     def matches(self, pattern: re.Pattern[str], bare: bool = False) -> bool:
         """Whether ``pattern`` occurs in the head (``bare``: without comments), searched once for all the
         flavors whose rules share it (five printer flavors' ``against`` tool change, for one)."""
         key = (pattern.pattern, bare)
         if key not in self.found:
-            self.found[key] = pattern.search(self.bare if bare else self.head) is not None
-        return self.found[key]
+            self.found[key] = pattern.search(self.bare if bare else self.head)
+        return self.found[key] is not None
+
+    def where(self, pattern: re.Pattern[str]) -> str:
+        """The head's line ``pattern`` matched first (after :meth:`matches`), quoted, and its number."""
+        match = self.found[(pattern.pattern, False)]
+        start = self.head.rfind("\n", 0, match.start()) + 1
+        end = self.head.find("\n", match.end())
+        line = self.head[start:end if end >= 0 else len(self.head)].strip()
+        shown = line if len(line) <= _SHOWN_CHARS else line[:_SHOWN_CHARS] + "..."
+        return f"{shown!r} on line {self.head.count(chr(10), 0, start) + 1}"
 
 
 def _e_words_on_moves(bare: str) -> bool:
@@ -188,7 +199,7 @@ def _score(rules: DetectRules, evidence: _Evidence) -> tuple[float, list[str]]:
     for pattern in rules.header:
         if evidence.matches(pattern):
             score += HEADER_POINTS
-            reasons.append(f"header matches /{pattern.pattern}/")
+            reasons.append(f"header {evidence.where(pattern)}")
     for pattern in rules.against:
         if evidence.matches(pattern):
             score -= AGAINST_POINTS
