@@ -144,14 +144,20 @@ class GcodeExporter:
 
     Examples
     --------
-    A Marlin program written for LinuxCNC keeps its moves:
+    A Marlin program written for LinuxCNC keeps its moves, and a warning
+    counts what LinuxCNC has no code for:
 
-    >>> import gcodekit
+    >>> import gcodekit, warnings
     >>> op = gcodekit.parse_program("G1 X10 F600 ; go\\nM104 S200\\n", flavor="marlin")
-    >>> print(GcodeExporter("rs274ngc").to_gcode(op), end="")
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     text = GcodeExporter("rs274ngc").to_gcode(op)
+    >>> print(text, end="")
     G1 X10 F600 (go)
     (gcodekit: M104 [set_hotend_temp] has no rs274ngc code; written as in the source)
     M104 S200
+    >>> print(caught[0].message)
+    1 problem(s) writing rs274ngc: M104 [set_hotend_temp] has no rs274ngc code; written as in the source
     """
 
     def __init__(self, flavor: str | Flavor = "rs274ngc", *, precision: int = 6, line_numbers: bool = False,
