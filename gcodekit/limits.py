@@ -13,7 +13,10 @@ it is made.
   subprogram repeats and wizards generate -- each against the same limit.
 * ``max_iterations`` (:data:`MAX_ITERATIONS`): loop iterations and
   subprogram repeats (``M98 L``), all loops together; a repeat count larger
-  than what is left is refused before the first repeat runs.
+  than what is left is refused before the first repeat runs.  A loop that
+  reads the machine each time round (a probe's result), each iteration a
+  machine run, stops earlier: as soon as one iteration changes nothing
+  (see :class:`~gcodekit.preprocess.ControlFlowStage`).
 
 Both are settable: ``gcode_to_operation(..., max_motions=..., max_iterations=...)``
 and the command line's ``--max-motions`` and ``--max-iterations``.

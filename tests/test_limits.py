@@ -16,6 +16,7 @@ from cli_helpers import run
 import gcodekit
 from gcodekit.errors import ConfigError, GcodeLimitError
 from gcodekit.limits import MAX_ITERATIONS, MAX_MOTIONS
+from gcodekit.parse.table import NAME_ID
 
 
 def limit_errors(op) -> list:
@@ -80,6 +81,53 @@ def test_an_endless_moving_loop_stops_at_the_iteration_limit():
     assert error.line == 5 and "more than max_iterations=2,000 loop iterations" in error.message
     assert len(op.motions()) == 2_001  # the first pass and 2,000 jumps back
     assert MAX_ITERATIONS == 100_000
+
+
+ENDLESS = "this loop never ends"
+
+
+def test_an_endless_probing_loop_stops_when_an_iteration_changes_nothing(shared_dir):
+    """explore.sh seed 3151337617 case 82: LinuxCNC's smartprobe.ngc without its ``#10=[#10+1]``.  Each
+    iteration reads the probe's result, so each costs a machine run, and reaching max_iterations took 113 s.
+    The second O2 iteration leaves every parameter and the machine as the first did: the loop stops there."""
+    text = (shared_dir / "corpus" / "linuxcnc" / "nc_files" / "smartprobe.ngc").read_text()
+    assert text.count("#10=[#10+1]") == 1
+    op = gcodekit.gcode_to_operation(text.replace("#10=[#10+1]", ""), "linuxcnc", plan=False)
+    (error,) = [d for d in op.diagnostics.errors if ENDLESS in d.message]
+    assert error.text.strip() == "O4 while [#5070 NE 0]" and error.severity == "error"
+    # the probes of three passes over the O4 test: the first pass, the one that repeats it, and the run up to
+    # the test that shows the repeat (G38.5, G38.3 in the O4 loop, G38.2 after it, and the first G0 Z)
+    assert 3 <= int((op.table.name == NAME_ID["probe"]).sum()) <= 9
+    with pytest.raises(GcodeLimitError, match=ENDLESS):
+        gcodekit.gcode_to_operation(text.replace("#10=[#10+1]", ""), "linuxcnc", plan=False, mode="strict")
+
+
+@pytest.mark.parametrize("loop", [
+    # the same probe at the same place, and a result nothing changes
+    "#1=1\no1 while [#1 GT 0]\nG38.3 Z-1 F100\n#2=#5063\nG0 Z1\no1 endwhile\nM2\n",
+    # do-while, reading the machine's position
+    "G0 X0\no2 do\nG1 X5 F100\nG1 X0\n#3=#5420\no2 while [#3 LT 1]\nM2\n",
+])
+def test_endless_loops_reading_the_machine_are_stopped_early(loop):
+    op = gcodekit.gcode_to_operation(loop, "linuxcnc", plan=False)
+    assert [d.line for d in op.diagnostics.errors if ENDLESS in d.message] == [2 if "o1" in loop else 6]
+    assert len(op.motions()) <= 12
+
+
+def test_a_loop_that_changes_only_the_machine_is_not_called_endless():
+    """No parameter changes here (the test reads the position, which the G91 moves change): the machine's
+    state differs at every test, and the loop ends at X = 10 after ten moves."""
+    text = "G91\no1 while [#5420 LT 10]\nG1 X1 F600\no1 endwhile\nM2\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+    assert not op.diagnostics.errors
+    assert op.waypoints["x"].max() == 10.0 and len(op.motions()) == 10
+
+
+def test_a_loop_without_the_machine_is_left_to_the_iteration_limit():
+    """Its iterations are cheap; nothing is compared (the same parameters at each test: X0 written forever)."""
+    op = gcodekit.gcode_to_operation("o1 while [1]\nG1 X0 F600\no1 endwhile\nM2\n", "linuxcnc", plan=False,
+                                     max_iterations=500)
+    assert [d.message for d in limit_errors(op)] == ["more than max_iterations=500 loop iterations"]
 
 
 def test_generated_blocks_count_against_max_motions():

@@ -14,6 +14,7 @@ held whole).
 
 from __future__ import annotations
 
+import pickle
 import re
 from typing import Callable, Iterator
 
@@ -59,6 +60,7 @@ class MachineFeedback:
         self.applied = 0  # probes whose results went to the store
         self.store = None
         self.state_parameters = flavor.state_parameters == "linuxcnc"
+        self.runs = 0  # times the held lines were emulated
 
     def watch(self, lines: Iterator, store) -> Iterator:
         """Pass ``lines`` on, noting probe moves; yields only the lines left at the end.
@@ -96,10 +98,19 @@ class MachineFeedback:
         self._catch_up()
         set_machine_parameter(self.machine, key, value)
 
+    def fingerprint(self) -> bytes:
+        """The held lines emulated, then what later lines can read or depend on: the machine's state,
+        tools and probe results and the probes not yet written to the store (see ``MachineView``)."""
+        self._catch_up()
+        m = self.machine
+        return pickle.dumps((m.state, m.tools, m._table_z, m._table_w, m.probe_result, m.out_of_budget,
+                             m.probes - self.applied, self.probed))
+
     def _catch_up(self) -> None:
         """Emulate the held lines."""
         if not self.held:
             return
+        self.runs += 1
         held, self.held = self.held, []
         try:
             self.emulate(read_source_lines(held, self.flavor, self.diagnostics), 0)

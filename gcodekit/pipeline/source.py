@@ -62,7 +62,7 @@ def program_blocks(program: Program, flavor: Flavor, diagnostics: Diagnostics, b
         store = ParameterStore(system=feedback.system, system_writes=feedback) if feedback is not None else None
         stages = [ControlFlowStage(flavor, store, search_path=search_path, fanuc_subs=fanuc_subs,
                                    max_iterations=limits.max_iterations,
-                                   max_motions=limits.max_motions)] if flavor.parameters and (
+                                   max_motions=limits.max_motions, machine=feedback)] if flavor.parameters and (
             needs_parameters(text) or _O_WORD_LINE.search(text) or _SUBPROGRAM_M.search(text)) else []
         if not stages:
             feedback = None  # no parameters for the machine to give

@@ -45,6 +45,15 @@ CALL_PARAMETERS = 30
 SystemParameters = Callable[[int | str], float | None]
 
 
+class MachineView(Protocol):
+    """The machine behind a store's system parameters, as a loop sees it (the pipeline's feedback)."""
+
+    runs: int  # times the machine ran the lines held for it
+
+    def fingerprint(self) -> bytes:
+        """Run the held lines, then every machine state a later line can read or depend on, as bytes."""
+
+
 class SystemWrites(Protocol):
     """System parameters a program may write (LinuxCNC's ``#5221``, a stored work offset)."""
 
@@ -224,6 +233,13 @@ class ParameterStore:
         self._locals, saved = self._calls.pop()
         if saved is not None:
             self._numbered[1 : CALL_PARAMETERS + 1] = saved
+
+    def snapshot(self) -> tuple:
+        """Every value the store holds, comparable with ``==`` (a loop that changed nothing, see
+        :class:`~.flow.run.Run`): numbered, global and local parameters and the callers' saved ones."""
+        return (tuple(self._numbered), tuple(sorted(self._globals.items())), tuple(sorted(self._locals.items())),
+                tuple((tuple(sorted(names.items())), None if saved is None else tuple(saved))
+                      for names, saved in self._calls))
 
     @property
     def call_depth(self) -> int:

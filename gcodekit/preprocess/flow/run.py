@@ -67,6 +67,8 @@ class Run:
         # rs274 2.9: after a ``break`` out of a ``while`` loop, the next ``while`` that closes a
         # ``do`` does not loop back (the do's body runs once), wherever that do is
         self.broke_while = False
+        # per loop (its code and test), what the last test saw: see _check_endless
+        self.loop_states: dict[tuple[int, int], tuple] = {}
 
     # -- running -------------------------------------------------------------
 
@@ -153,11 +155,16 @@ class Run:
                 self.pc += 1
             elif self._condition(st):
                 self.tick(st)
+                self._check_endless(st)
                 self.pc = st.start + 1
             else:
                 self.pc += 1
         elif k == "while":
-            self.pc = self.pc + 1 if self._condition(st) else _after(st, items)
+            if self._condition(st):
+                self._check_endless(st)
+                self.pc += 1
+            else:
+                self.pc = _after(st, items)
         elif k == "endwhile":
             self.tick(st)
             self.pc = st.start
@@ -224,6 +231,34 @@ class Run:
         return value is not None and value != 0.0
 
     # -- limits --------------------------------------------------------------
+
+    def _check_endless(self, st: OWord) -> None:
+        """Stop a loop, about to run again, whose last iteration changed nothing and read the machine.
+
+        Such an iteration costs a machine run, so an endless loop would take
+        minutes to reach ``max_iterations``.  When two tests of the loop in a
+        row find the parameters, the run's loops and calls and (after the
+        lines held for it have run) the machine the same, the iteration
+        between them leaves everything as it found it: every later one
+        repeats it, and the loop never ends (a probe loop missing its
+        counter's increment).  Iterations that do not read the machine are
+        not compared: they are cheap, and ``max_iterations`` stops them.
+        """
+        machine = self.stage.machine
+        if machine is None:
+            return
+        key = (id(self.code), self.pc)
+        before = self.loop_states.get(key)
+        if before is None or before[0] == machine.runs:  # the first test, or an iteration without the machine
+            self.loop_states[key] = (machine.runs, None, None)
+            return
+        state = (self.store.snapshot(), self.pc, tuple((id(f.code), f.pc, f.left) for f in self.frames),
+                 tuple(sorted(self.counters.items())), self.broke_while)
+        seen = machine.fingerprint() if state == before[1] else None
+        if seen is not None and seen == before[2]:
+            self.limit(st, "this loop never ends: an iteration left every parameter and the machine as the one "
+                       "before it did, so the next ones would repeat it (LinuxCNC runs it forever)")
+        self.loop_states[key] = (machine.runs, state, seen)
 
     def check_repeats(self, st: OWord | SourceLine, count: int, what: str) -> None:
         """Refuse ``count`` repeats up front when they would pass ``max_iterations``."""

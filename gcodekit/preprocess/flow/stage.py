@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Iterable, Iterator, Sequence
 from ...errors import Diagnostics
 from ...limits import MAX_ITERATIONS, MAX_MOTIONS
 from .run import Run
-from ..parameters import ParameterStage, ParameterStore
+from ..parameters import MachineView, ParameterStage, ParameterStore
 
 if TYPE_CHECKING:
     from ..lines import SourceLine
@@ -54,6 +54,13 @@ class ControlFlowStage:
         Limits; default :data:`~gcodekit.limits.MAX_ITERATIONS`,
         :data:`MAX_CALL_DEPTH`, :data:`MAX_LINES`,
         :data:`~gcodekit.limits.MAX_MOTIONS`.
+    machine : MachineView, optional
+        The machine behind the store's system parameters.  A loop whose
+        iterations read it costs a machine run each, so an endless one
+        would take minutes to reach ``max_iterations``: it is stopped as
+        soon as an iteration leaves the parameters, the loops' state and
+        the machine exactly as the one before (the next ones can only
+        repeat it).
 
     Examples
     --------
@@ -72,8 +79,9 @@ class ControlFlowStage:
     def __init__(self, flavor: Flavor, store: ParameterStore | None = None, *,
                  search_path: Sequence[str | os.PathLike] = (), fanuc_subs: bool = True,
                  max_iterations: int = MAX_ITERATIONS, max_call_depth: int = MAX_CALL_DEPTH,
-                 max_lines: int = MAX_LINES, max_motions: int = MAX_MOTIONS):
+                 max_lines: int = MAX_LINES, max_motions: int = MAX_MOTIONS, machine: MachineView | None = None):
         self.flavor = flavor
+        self.machine = machine
         self.parameters = ParameterStage(flavor, store)
         self.store = self.parameters.store
         self.search_path = [Path(p) for p in search_path]
