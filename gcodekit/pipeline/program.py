@@ -120,10 +120,11 @@ def note_other_dialect(program: Program, flavor: Flavor, diagnostics: Diagnostic
     the flavor itself nor one it inherits from, and no close candidate
     that is: :meth:`Detection.rules_out`; a Marlin program read as Klipper
     gets none, a Klipper program read as Marlin does, but between dialects
-    of one family only when the reading gave errors).  It is a warning, or an info when it explains only infos (codes without
-    meaning, which firmware add freely).  Detection reads the head only, and
-    only for a program with such diagnostics.  ``machine`` names the preset
-    the flavor came with, when the caller gave a machine and no flavor.
+    of one family only when the reading gave errors).  It is a warning, or
+    an info when it explains only infos (codes without meaning, which
+    firmware add freely).  Detection reads the head only, and only for a
+    program with such diagnostics.  ``machine`` names the preset the
+    flavor came with, when the caller gave a machine and no flavor.
     """
     if diagnostics.has_error:
         found, severity = "the errors", "warning"
