@@ -11,6 +11,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+import pytest
 from cli_helpers import run
 
 from gcodekit import cli
@@ -188,3 +189,14 @@ def test_a_terminated_report_ends_its_chromium_and_leaves_no_profile(tmp_path):
         assert list(temp.iterdir()) == []  # the exit handlers ran: Chromium's profile is gone
     finally:
         shutil.rmtree(temp)
+
+
+@pytest.mark.parametrize("environment, advice", [({}, False), ({"NUMPY_MADVISE_HUGEPAGE": "1"}, True)])
+def test_the_command_turns_numpy_s_huge_page_advice_off_unless_the_environment_chose(environment, advice):
+    """The command (``cli.run``) sets NUMPY_MADVISE_HUGEPAGE=0 before NumPy is imported, so NumPy in the
+    command and its children gives the kernel no huge-page advice; a value the user set is kept."""
+    probe = ("import gcodekit.cli as cli, sys; assert 'numpy' not in sys.modules; cli._without_huge_page_advice(); "
+             "import numpy; print(numpy._core.multiarray._set_madvise_hugepage(True))")
+    env = {k: v for k, v in os.environ.items() if k != "NUMPY_MADVISE_HUGEPAGE"} | environment
+    done = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == str(advice)
