@@ -141,8 +141,9 @@ def note_other_dialect(program: Program, flavor: Flavor, diagnostics: Diagnostic
         return  # a relative's codes it lacks (Prusa's M862 on Marlin) are only noted: the choice may be the user's
     name = detection.name
     if machine:
+        preset = default_machine_for(name)
         read_as = f"the {machine} machine's flavor"
-        advice = f"a machine for it, e.g. --machine {default_machine_for(name)} (machine={default_machine_for(name)!r})"
+        advice = f"a machine for it, e.g. --machine {preset} (machine={preset!r})"
     else:
         read_as, advice = "the flavor given", f"--flavor {name} (flavor={name!r})"
     diagnostics.report_first(1, 1, f"the program looks written for {name!r} ({'; '.join(detection.evidence)}), but "

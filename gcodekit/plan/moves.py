@@ -148,7 +148,7 @@ class PlannedMoves:
 
     @property
     def speed_v(self) -> np.ndarray:
-        return self._speed_v if self._speed_v is not None else self.source.speed_v(self.waypoint)
+        return self.speeds(slice(None))
 
     @property
     def row(self) -> np.ndarray:
