@@ -6,6 +6,14 @@ gcodekit follows it with straight chords that stay within
 ``spline_tolerance`` (mm, from the machine preset) of it, so distances,
 times, pictures and the transpiler's plain G1 output all use the real path.
 
+Every curve is cut into (rational) Bézier pieces and each piece is halved
+(de Casteljau) until its control points lie within the tolerance of the
+chord between its ends.  A piece lies inside the convex hull of its
+control points, and the points within the tolerance of a segment form a
+convex set, so the whole curve is within the tolerance of its chords, even
+where it turns back on itself, which checking sampled curve points cannot
+promise.
+
 The NURBS knot vector is the clamped uniform one LinuxCNC builds from the
 number of control points and the order L (``knot_vector_creator`` in
 ``nurbs_additional_functions.cc``): the curve starts at the first control
@@ -14,37 +22,16 @@ point and ends at the last.
 Examples
 --------
 >>> import numpy as np
->>> chords = polyline(lambda t: quadratic_bezier(np.array([[0, 0], [5, 5], [10, 0]], float), t), 0.01)
+>>> chords = bezier_chords(np.array([[0, 0], [5, 5], [10, 0]], float), 0.01)
 >>> chords[0].tolist(), chords[-1].tolist()
 ([0.0, 0.0], [10.0, 0.0])
 """
 
 from __future__ import annotations
 
-from typing import Callable
-
 import numpy as np
 
-#: Curve points (n, 2) at parameters t (n,) in [0, 1].
-Curve = Callable[[np.ndarray], np.ndarray]
-
 _MAX_CHORDS = 1 << 16  # a curve is never cut into more chords than this
-
-
-def cubic_bezier(points: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Points of the cubic Bézier with control points ``points`` (4, 2) at ``t``."""
-    t = np.asarray(t, float)[:, None]
-    s = 1.0 - t
-    p0, p1, p2, p3 = points
-    return s**3 * p0 + 3 * s * s * t * p1 + 3 * s * t * t * p2 + t**3 * p3
-
-
-def quadratic_bezier(points: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Points of the quadratic Bézier with control points ``points`` (3, 2) at ``t``."""
-    t = np.asarray(t, float)[:, None]
-    s = 1.0 - t
-    p0, p1, p2 = points
-    return s * s * p0 + 2 * s * t * p1 + t * t * p2
 
 
 def clamped_knots(n_points: int, order: int) -> np.ndarray:
@@ -55,56 +42,88 @@ def clamped_knots(n_points: int, order: int) -> np.ndarray:
     return knots / knots[-1]
 
 
-def nurbs(points: np.ndarray, weights: np.ndarray, order: int, t: np.ndarray) -> np.ndarray:
-    """Points of the NURBS curve (control ``points`` (n, 2), ``weights`` (n,), order) at ``t``.
+def bezier_chords(points: np.ndarray, tolerance: float, weights: np.ndarray | None = None) -> np.ndarray:
+    """Chord end points (m, 2) of the Bézier curve with control ``points`` (n, 2), each chord within ``tolerance``.
 
-    Cox-de Boor recursion on all parameters at once.
+    ``weights`` (n,), all positive, make it a rational Bézier; None is all ones.
     """
-    t = np.asarray(t, float)
-    knots = clamped_knots(len(points), order)
-    # order-1 basis: the span holding t (the last span also holds t = 1)
-    last = len(knots) - order - 1
-    span = np.clip(np.searchsorted(knots, t, side="right") - 1, order - 1, last)
-    basis = (np.arange(len(knots) - 1)[None, :] == span[:, None]).astype(float)
-    for k in range(2, order + 1):
-        new = np.zeros((t.size, len(knots) - k))
-        for i in range(len(knots) - k):
-            left = knots[i + k - 1] - knots[i]
-            right = knots[i + k] - knots[i + 1]
-            if left > 0:
-                new[:, i] += (t - knots[i]) / left * basis[:, i]
-            if right > 0:
-                new[:, i] += (knots[i + k] - t) / right * basis[:, i + 1]
-        basis = new
-    weighted = basis * weights[None, :]
-    return weighted @ points / weighted.sum(axis=1, keepdims=True)
+    weights = np.ones(len(points)) if weights is None else np.asarray(weights, float)
+    return _chords(_homogeneous(points, weights)[None], tolerance)
 
 
-def polyline(curve: Curve, tolerance: float) -> np.ndarray:
-    """Chord end points (m, 2) from the curve's start to its end, each chord within ``tolerance``.
+def nurbs_chords(points: np.ndarray, weights: np.ndarray, order: int, tolerance: float) -> np.ndarray:
+    """Chord end points (m, 2) of LinuxCNC's NURBS (control ``points`` (n, 2), positive ``weights``, order L)."""
+    return _chords(_bezier_pieces(_homogeneous(points, weights), order), tolerance)
 
-    Chords are halved until the curve's points a quarter, half and three
-    quarters along each chord's parameter interval lie within the tolerance
-    of the chord (the segment, so a curve that doubles back on itself is
-    followed to its tip; at such a cusp the tip can still lie up to about
-    twice the tolerance from the chords).
+
+def _homogeneous(points: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Control points as (w x, w y, w): the rational curve is the projection of a polynomial one."""
+    return np.column_stack([np.asarray(points, float) * weights[:, None], weights])
+
+
+def _bezier_pieces(control: np.ndarray, order: int) -> np.ndarray:
+    """The NURBS's homogeneous ``control`` points (n, 3) as Bézier pieces (k, order, 3), in curve order.
+
+    Boehm's knot insertion raises every inner knot to the multiplicity of
+    the degree; then each knot span is one Bézier piece, sharing its end
+    points with its neighbours.
     """
-    t = np.linspace(0.0, 1.0, 9)
-    while True:
-        points = curve(t)
-        a, b = points[:-1], points[1:]
-        chord = b - a
-        chord2 = np.maximum(np.einsum("ij,ij->i", chord, chord), 1e-300)
-        too_far = np.zeros(len(chord), bool)
-        for f in (0.25, 0.5, 0.75):  # curve points inside each chord's parameter interval
-            off = curve(t[:-1] + f * np.diff(t)) - a
-            along = np.clip(np.einsum("ij,ij->i", off, chord) / chord2, 0.0, 1.0)
-            gap = off - along[:, None] * chord  # from the nearest point of the chord (not of its line)
-            too_far |= np.hypot(gap[:, 0], gap[:, 1]) > tolerance
-        if not too_far.any() or t.size > _MAX_CHORDS:
-            return points
-        mid_t = 0.5 * (t[:-1] + t[1:])
-        t = np.sort(np.r_[t, mid_t[too_far]])
+    degree = order - 1
+    knots = list(clamped_knots(len(control), order))
+    control = list(control)
+    for u in sorted(set(knots[order:-order])):
+        for _ in range(degree - knots.count(u)):
+            span = max(i for i, k in enumerate(knots) if k <= u)
+            inserted = []
+            for i in range(span - degree + 1, span + 1):
+                alpha = (u - knots[i]) / (knots[i + degree] - knots[i])
+                inserted.append(alpha * control[i] + (1.0 - alpha) * control[i - 1])
+            control[span - degree + 1:span] = inserted
+            knots.insert(span + 1, u)
+    control = np.array(control)
+    starts = np.arange(0, len(control) - 1, degree)
+    return control[starts[:, None] + np.arange(order)[None, :]]
+
+
+def _chords(pieces: np.ndarray, tolerance: float) -> np.ndarray:
+    """Chord end points through the homogeneous Bézier ``pieces`` (k, n, 3), halving each until it is flat."""
+    start = pieces[0, 0, :2] / pieces[0, 0, 2]
+    place = np.arange(len(pieces), dtype=float)  # where a piece starts along the curve, in whole pieces
+    width = np.ones(len(pieces))
+    ends, end_places = [], []
+    while len(pieces):
+        xy = pieces[..., :2] / pieces[..., 2:]
+        flat = _within(xy, tolerance)
+        if sum(map(len, ends)) + len(pieces) + int(np.count_nonzero(~flat)) > _MAX_CHORDS:
+            flat[:] = True
+        ends.append(xy[flat, -1])
+        end_places.append(place[flat])
+        pieces, place, width = pieces[~flat], place[~flat], width[~flat] / 2
+        pieces = np.concatenate(_halves(pieces))
+        place, width = np.concatenate([place, place + width]), np.concatenate([width, width])
+    order = np.argsort(np.concatenate(end_places), kind="stable")
+    return np.vstack([start, np.concatenate(ends)[order]])
+
+
+def _within(xy: np.ndarray, tolerance: float) -> np.ndarray:
+    """Whether each piece's control points (k, n, 2) lie within ``tolerance`` of the segment between its ends."""
+    a, chord = xy[:, :1], xy[:, -1:] - xy[:, :1]
+    off = xy[:, 1:-1] - a
+    chord2 = np.maximum(np.sum(chord * chord, axis=2), 1e-300)
+    along = np.clip(np.sum(off * chord, axis=2) / chord2, 0.0, 1.0)
+    gap = off - along[..., None] * chord
+    return np.all(np.sum(gap * gap, axis=2) <= tolerance * tolerance, axis=1)
+
+
+def _halves(pieces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each piece (k, n, 3) cut at its middle parameter (de Casteljau): the first halves and the second halves."""
+    left, right = [pieces[:, 0]], [pieces[:, -1]]
+    level = pieces
+    while level.shape[1] > 1:
+        level = 0.5 * (level[:, :-1] + level[:, 1:])
+        left.append(level[:, 0])
+        right.append(level[:, -1])
+    return np.stack(left, axis=1), np.stack(right[::-1], axis=1)
 
 
 #: Spline commands (names in :data:`gcodekit.syntax.flavor.COMMANDS`).
@@ -151,7 +170,7 @@ class SplineBlocks:
                 raise ValueError("Must specify both I and J with G5.1")
             control = start + np.array([params["I"], params["J"]]) * scale
             points = np.array([start, control, end])
-            return polyline(lambda t: quadratic_bezier(points, t), self.tolerance)
+            return bezier_chords(points, self.tolerance)
         if name == "spline_cubic":
             if "P" not in params or "Q" not in params:
                 raise ValueError("Must specify both P and Q with G5")
@@ -160,7 +179,7 @@ class SplineBlocks:
             first = np.array([params["I"], params["J"]]) * scale if "I" in params else -self._handle
             self._handle = np.array([params["P"], params["Q"]]) * scale
             points = np.array([start, start + first, end + self._handle, end])
-            return polyline(lambda t: cubic_bezier(points, t), self.tolerance)
+            return bezier_chords(points, self.tolerance)
         return self._add_control_point(name, params, start, end)
 
     def discard(self) -> None:
@@ -172,7 +191,7 @@ class SplineBlocks:
             self._order = int(params.get("L", 3))
             self._points, self._weights = [start], [1.0]
             if "X" not in params and "Y" not in params:  # the block only opens the curve
-                self._weights[0] = float(params.get("P", 1.0))
+                self._weights[0] = float(params.get("P", 1.0))  # rs274 takes 0 or less here too: see G5.3
                 return None
         elif not self._order:
             raise ValueError("Cannot use a NURBS control point without G5.2 first")
@@ -194,4 +213,6 @@ class SplineBlocks:
             raise ValueError(f"You must specify a number of control points at least equal to the order L = {order}")
         if order < 2:
             raise ValueError(f"the order L of a NURBS must be at least 2, not {order}")
-        return polyline(lambda t: nurbs(points, weights, order, t), self.tolerance)
+        if not weights[0] > 0:  # no curve to follow (the handler warns at G5.2): a line to its end
+            return points[[0, -1]]
+        return nurbs_chords(points, weights, order, self.tolerance)

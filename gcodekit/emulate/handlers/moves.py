@@ -30,6 +30,10 @@ def spline(ctx: Context, block: Block) -> Outcome | None:
         problem = "Splines must be in the XY plane"
     elif name in ("spline_cubic", "spline_quadratic") and any(letter in params for letter in "ZABC"):
         problem = "Splines may not have motion in Z, A, B, or C"
+    if name == "nurbs_start" and not ("X" in params or "Y" in params) and not params.get("P", 1.0) > 0:
+        ctx.diagnostics.report(block.line, 1, f"G5.2's weight P{params['P']:g} is not positive: rs274 takes it, but a "
+                               "NURBS with such a weight has no well-defined path; gcodekit moves in a straight line "
+                               "to the curve's end", severity="warning", kind="machine")
     try:
         if problem:
             raise ValueError(problem)
