@@ -356,3 +356,40 @@ def test_figures_of_bambu_studio_and_creality_print_headers():
     # "; filament cost = 0.65; total filament used [g] = 32.46" is two settings on one line
     assert (f.slicer, f.filament_g, f.filament_cost, f.layers) == ("Creality Print", 32.46, 0.65, 20)
     assert f.time_s == 39 * 60 + 45  # "estimated printing time (normal mode) = 39m 45s"
+
+
+def test_figures_of_kisslicer_as_a_volume_and_of_pycam():
+    path = shared_file("realworld", "kisslicer_1.1.0.14_cube.gcode")
+    text = text_of(path)
+    # "; KISSlicer - FREE", "; version 1.1.0.14", "; Estimated Build Time:   7.01 minutes",
+    # "; Estimated Build Volume: 0.681 cm^3"
+    f = gcodekit.gcode_to_operation(path, plan=False).slicer_figures()
+    assert (f.slicer, f.version, f.filament_mm) == ("KISSlicer", header_value(text, r"^; version (\S+)$"), None)
+    assert f.time_s == pytest.approx(float(header_value(text, r"^; Estimated Build Time:\s+([\d.]+) minutes")) * 60)
+    assert f.filament_cm3 == float(header_value(text, r"^; Estimated Build Volume: ([\d.]+) cm\^3"))
+    # its E words are relative, which the program leaves to the firmware: with M83 after its G90 the volume pushed
+    # (the E words' sum over the 3 mm filament's section, by hand below) is the slicer's figure
+    fixed = text.replace("G90\n", "G90\nM83\n", 1)
+    e_sum = sum(float(e) for e in re.findall(r"^G1 .*E(-?[\d.]+)", fixed, re.M))
+    assert e_sum * np.pi * 1.5**2 / 1000 == pytest.approx(0.681, rel=1e-3)
+    rows = compare(gcodekit.gcode_to_operation(fixed, "marlin").summary())
+    volume = next(r for r in rows if r["figure"] == "filament volume")
+    assert (volume["slicer"], volume["gcodekit"]) == (0.681, pytest.approx(e_sum * np.pi * 1.5**2 / 1000, rel=1e-9))
+    assert [r["figure"] for r in rows] == ["time", "filament volume"]
+
+    pycam = shared_file("realworld", "pycam_0.5.1.1_shapeoko_cal.ngc")
+    f = gcodekit.gcode_to_operation(pycam, plan=False).slicer_figures()
+    # ";PYCAM-META-DATA: Version: 0.5.1.1", ";Estimated machine time: 17 minutes"
+    assert (f.slicer, f.version, f.time_s, f.filament_cm3) == ("PyCAM", "0.5.1.1", 17 * 60, None)
+
+
+def test_cam_program_report_row_is_what_the_cam_program_says():
+    from gcodekit.report.build import report_data
+    from gcodekit.report.html import program_page
+
+    op = gcodekit.gcode_to_operation(";PYCAM-META-DATA: Version: 0.5.1.1\n;Estimated machine time: 1 minutes\n"
+                                     "G21 G90 F600\nG1 X100\nM2\n", "linuxcnc")
+    page = program_page(report_data(op), collections.defaultdict(lambda: None))
+    row = re.search(r"<th>CAM says</th><td>(.*?)</td>", page)[1]
+    # 100 mm at 600 mm/min: 10 s and the ramps, against PyCAM's minute
+    assert row.startswith("PyCAM 0.5.1.1: time 0:01:00 (gcodekit -83.")

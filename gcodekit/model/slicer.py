@@ -10,8 +10,10 @@ them, so that gcodekit's figures can be set beside the slicer's.
 Recognised: PrusaSlicer, SuperSlicer, Slic3r (Prusa edition), OrcaSlicer,
 Bambu Studio and Creality Print (``; name = value`` headers, footers and
 configuration block), CuraEngine 4 and 5 (``;TIME:``, ``;Filament used:``,
-``;LAYER_COUNT:``, one per object when they are printed one at a time) and
-the Cura 15 legacy header.  Only the comments near the
+``;LAYER_COUNT:``, one per object when they are printed one at a time),
+the Cura 15 legacy header, KISSlicer (``; Estimated Build Time:``, its
+filament as a volume) and the CAM program PyCAM (``;Estimated machine
+time:``).  Only the comments near the
 start and the end of the file are read, and the progress marks wherever they
 are.
 
@@ -53,7 +55,12 @@ _BANNERS = (
     (re.compile(r"^Generated with Cura_SteamEngine\s+(\S+)"), "CuraEngine"),
     # the Cura 15 legacy engine names no version: ";Sliced at: Thu 25-05-2017 10:25:01"
     (re.compile(r"^Sliced at: \w+ \d\d-\d\d-\d{4} \d\d:\d\d"), "Cura (legacy)"),
+    # "; KISSlicer - FREE", its version two comments on: "; version 1.1.0.14"
+    (re.compile(r"^KISSlicer\b"), "KISSlicer"),
+    (re.compile(r"^PYCAM-META-DATA: Version:\s*(\S+)"), "PyCAM"),
 )
+# a version the banner leaves to a comment of its own
+_VERSION = re.compile(r"^version\s+(\d\S*)$")
 _NAMES = {"creality_print": "Creality Print", "bambustudio": "BambuStudio"}
 # "; key = value" (the Slic3r family) and ";KEY:value" (Cura)
 _SETTING = re.compile(r"^([A-Za-z_][\w .\[\]()]*?)\s*(?:=|:)\s*(.*)$")
@@ -243,16 +250,22 @@ def slicer_figures(op: "Operation") -> SlicerFigures:
                     values["slicer"] = name or _NAMES.get(m[1].lower(), m[1])
                     values["version"] = m[m.lastindex] if m.lastindex else None
                     break
+        elif values["slicer"] == "KISSlicer" and values["version"] is None and _VERSION.match(text):
+            values["version"] = _VERSION.match(text)[1]
         for part in _SEVERAL.split(text):
             m = _SETTING.match(part)
             if m:
                 settings.setdefault(m[1].strip(), m[2].strip())
     get = settings.get
     time_s = next((parse_duration(get(k)) for k in ("estimated printing time (normal mode)", "total estimated time",
-                                                    "TIME", "Print time") if get(k)), None)
+                                                    "TIME", "Print time", "Estimated Build Time",
+                                                    "Estimated machine time") if get(k)), None)
     time_silent = parse_duration(get("estimated printing time (silent mode)", "")) or None
     filament_mm = _total(get("filament used [mm]", ""))
     cm3 = _total(get("filament used [cm3]", ""))
+    if cm3 is None and get("Estimated Build Volume"):  # KISSlicer: "0.681 cm^3"
+        m = re.match(r"\s*([\d.]+)\s*cm\^?3", get("Estimated Build Volume", ""))
+        cm3 = float(m[1]) if m else None
     grams = _total(get("total filament used [g]", "")) or _total(get("filament used [g]", ""))
     if filament_mm is None and get("Filament used"):  # Cura: "1.22747m" (legacy: "1.707m 5.0g")
         metres = re.findall(r"([\d.]+)m\b", get("Filament used", ""))
@@ -297,7 +310,9 @@ def compare(record: Mapping[str, Any]) -> list[dict[str, Any]]:
 
     Returns one row per figure both sides have: ``figure``, ``gcodekit``,
     ``slicer`` and ``difference`` (gcodekit's less the slicer's, relative to
-    the slicer's; None when the slicer's is 0).
+    the slicer's; None when the slicer's is 0).  A slicer that gives its
+    filament only as a volume (KISSlicer) is compared as ``filament volume``,
+    in cm3.
 
     Examples
     --------
@@ -312,4 +327,10 @@ def compare(record: Mapping[str, Any]) -> list[dict[str, Any]]:
             continue
         rows.append({"figure": label, "gcodekit": ours, "slicer": their,
                      "difference": (ours - their) / their if their else None})
+    their_cm3, ours_mm3 = theirs.get("filament_cm3"), record.get("volume_mm3")
+    if theirs.get("filament_mm") is None and their_cm3 is not None and ours_mm3 is not None:
+        ours = ours_mm3 / 1000.0
+        rows.insert(len(rows) - (rows[-1]["figure"] == "layers" if rows else 0),
+                    {"figure": "filament volume", "gcodekit": ours, "slicer": their_cm3,
+                     "difference": (ours - their_cm3) / their_cm3 if their_cm3 else None})
     return rows
