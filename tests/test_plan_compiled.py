@@ -253,19 +253,24 @@ def test_gathered_move_points_are_the_stored_ones(text, name):
     "G28\nG1 X0 Y0 F600\nG1 X10 E1\nG1 X10\nG1 E2\nG92 X0\nG1 X5 E3\nG28 X\nG1 X3 Y3\nG1 Z0.3\n",
     # relative E from a signed zero on: the running sum starts at -0.0, as np.cumsum's does
     "M83\nG1 X1 E-0 F600\nG1 X2 E0.1\nG1 E-0.3\nG1 X3 E0.1234567\nG92 E0\nG1 X4 E1e-9\nG1 X5 E0.2\n",
+    # M220 scales the speeds the loop reads at each waypoint; G0 runs at the feed (Klipper) or the rapid rate
+    "G1 X1 F600\nM220 S37\nG1 X2 Y1 E1\nG0 X5 F9000\nM220 S150\nG1 X7\nG0 Y3\n",
 ])
-def test_klippers_compiled_set_up_reads_gathered_points_as_stored_ones(text):
+@pytest.mark.parametrize("machine", ["klipper", "makerbot"])
+def test_klippers_compiled_set_up_reads_gathered_points_as_stored_ones(text, machine):
     """Stored points, gathered points with the extruder summed in the loop (the planner's way) and gathered
     points with the summed extruder column handed over give the same set-up, bit for bit."""
     from gcodekit.plan import klipper
     from gcodekit.plan.points import MoveEnds, RunningSum
 
-    op = gcodekit.gcode_to_operation(text, "klipper", plan=False)
+    op = gcodekit.gcode_to_operation(text, machine, plan=False)
     config = klipper.KlipperConfig()
     rows, limits = klipper._velocity_limits(op, config)
+    factor = moves_module.speed_factor(op)
     out = []
     for way in ("stored", "summed in the loop", "sums handed over"):
-        moves = moves_module.firmware_moves(op, gathered=way != "stored")
+        moves = moves_module.firmware_moves(op, factor, gathered=way != "stored")
+        assert moves.read_from_source == (way != "stored")  # gathered: speeds and rows read in the loop
         if way == "sums handed over":
             ends = moves.start.ends
             assert isinstance(ends.columns[3], RunningSum)
@@ -289,6 +294,24 @@ def test_a_running_sum_reads_as_np_cumsum():
     assert column._sums is None and len(column) == 6  # nothing summed until read
     assert_bits_equal(column[np.array([0, 2, 5])], np.cumsum(de)[[0, 2, 5]], "indices")
     assert_bits_equal(np.asarray(column), np.cumsum(de), "whole")
+
+
+def test_a_running_sum_read_in_order_holds_only_a_stretch():
+    from gcodekit.plan.points import RunningSum
+
+    rng = np.random.default_rng(5)
+    de = rng.normal(size=50_000) * (rng.random(50_000) < 0.7)
+    de[0] = -0.0
+    reference = np.cumsum(de)
+    column = RunningSum(de)
+    waypoints = np.sort(rng.choice(50_000, 20_000, replace=False))
+    for lo in range(0, waypoints.size, 1000):  # Marlin's way: a block's ends, then its starts a move earlier
+        ends, starts = waypoints[lo:lo + 1000], np.maximum(waypoints[max(lo - 2, 0):lo + 999] - 1, 0)
+        assert_bits_equal(column[ends], reference[ends], "ends")
+        assert_bits_equal(column[starts], reference[starts], "starts")
+        assert column._sums is None and column._window.size < 10_000  # a stretch, not every sum
+    assert_bits_equal(column[np.array([3, 7])], reference[[3, 7]], "read back: every sum made once")
+    assert column._sums is not None
 
 
 def test_gathered_points_of_a_program_with_arcs_are_stored_chords():

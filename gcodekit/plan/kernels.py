@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import MissingDependencyError, check_choice
 from ..jit import compile_loops
+from ..parse.table import MOTION_RAPID
 
 __all__ = ["COMPILED_AFTER_MOVES", "ENGINES", "compiled", "engine", "using"]
 
@@ -214,7 +215,8 @@ def _classic_jerk(dx, dy, dz, de, speed_per_mm, nominal_speed, jx, jy, jz, je, r
     return vmax
 
 
-def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, speed_v, row, flush, limit_rows,
+def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, speed_v, row, by_waypoint, feed,
+                   command, motion, rapid_v, factor, flush, limit_rows,
                    max_velocity, max_accel, square_corner_velocity, minimum_cruise_ratio, initial, z_velocity, z_accel,
                    e_velocity, e_accel, corner_velocity, extrude_only_accel, no_limit_v2):
     """:func:`.klipper._move_block` over all moves: Move.__init__, limit_speed and calc_junction.
@@ -228,9 +230,13 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, 
     in force come from ``limit_rows`` (sorted) and their columns,
     ``initial`` (max_velocity, max_accel, square_corner_velocity,
     minimum_cruise_ratio) before the first, as :func:`.moves.in_force`.
+    Each move's requested speed and command row are ``speed_v`` and ``row``,
+    or, ``by_waypoint`` (gathered moves), read at its waypoint as
+    :class:`.moves.MoveSource` reads them: ``feed`` over 60 (``rapid_v`` for
+    a G0 unless NaN), times ``factor`` (unless empty), and ``command``.
     Returns move_d, accel, max_cruise_v2, delta_v2, mcr_delta_v2, cap and junction.
     """
-    n = speed_v.size
+    n = idx.size if by_waypoint else speed_v.size
     move_d_out = np.empty(n)
     accel_out = np.empty(n)
     max_cruise_v2_out = np.empty(n)
@@ -246,7 +252,17 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, 
     p_kinematic = False
     p_e_r = p_r0 = p_r1 = p_r2 = p_jd = 0.0
     for i in range(n):
-        r = row[i]
+        if by_waypoint:
+            w = idx[i]
+            r = command[w]
+            speed = feed[w] / 60.0
+            if rapid_v == rapid_v and motion[w] == MOTION_RAPID:
+                speed = rapid_v
+            if factor.size:
+                speed = speed * factor[w]
+        else:
+            r = row[i]
+            speed = speed_v[i]
         if j > 0 and limit_rows[j - 1] >= r:  # out of order (a loop ran rows again): search afresh
             j = np.searchsorted(limit_rows, r)
         while j < limit_rows.size and limit_rows[j] < r:
@@ -289,7 +305,6 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, 
             move_d = abs(de)
         inv_move_d = 1.0 / move_d if move_d > 0 else 0.0
         r0, r1, r2, e_r = dx * inv_move_d, dy * inv_move_d, dz * inv_move_d, de * inv_move_d
-        speed = speed_v[i]
         if kinematic:
             velocity = speed if (speed < max_v or speed != speed) else max_v
             accel = max_a

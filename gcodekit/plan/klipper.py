@@ -268,8 +268,16 @@ def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict,
         e = e.deltas if summing else e
         points = (np.zeros((0, 4)), np.zeros((0, 4)), True, *(np.asarray(c, float) for c in (x, y, z, e)), summing,
                   ends.idx, ends.chained)
+    if ends is not None and moves.read_from_source:  # each move's speed and row read at its waypoint, in the loop
+        src = moves.source
+        speeds_and_rows = (np.zeros(0), np.zeros(0, np.int32), True, np.asarray(src.feed, float), src.command,
+                           src.motion, np.nan if src.rapid_v is None else float(src.rapid_v),
+                           np.zeros(0) if src.factor is None else np.asarray(src.factor, float))
+    else:
+        speeds_and_rows = (np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row), False,
+                           np.zeros(0), np.zeros(0, np.int32), np.zeros(0, np.uint8), np.nan, np.zeros(0))
     out = compiled.klipper_moves(
-        *points, np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row), flush,
+        *points, *speeds_and_rows, flush,
         np.ascontiguousarray(rows, np.int64), *(np.ascontiguousarray(limits[k], float) for k in names),
         np.array([float(getattr(config, k)) for k in names]), float(config.max_z_velocity or config.max_velocity),
         float(config.max_z_accel or config.max_accel), float(config.max_e_velocity), float(config.max_e_accel),

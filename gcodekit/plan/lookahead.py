@@ -102,9 +102,8 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     del bound, increments
     forward_inc = delta_v2 if reuse_delta else delta_v2.copy()
     del delta_v2
-    cut = np.flatnonzero(free[:-1])
+    np.copyto(forward_inc[:-1], reverse_v2[1:], where=free[:-1])  # cut: no index arrays, most moves may be free
     del free
-    forward_inc[cut] = reverse_v2[cut + 1]
     entry_v2 = forward_min(reverse_v2, forward_inc, first=float(reverse_v2[0]), out=reverse_v2) if n else reverse_v2
     del forward_inc, reverse_v2
     return entry_v2, NextEntry(entry_v2, np.flatnonzero(rest_after), rest_v2)

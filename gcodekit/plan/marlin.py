@@ -330,7 +330,7 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
     (by the compiled loops of ``kernels`` when given, but for junction deviation's junctions)."""
     first = max(lo - 1, 0)  # the move before the block, for its junction
     sl = slice(first, hi)
-    row = moves.row[sl]
+    row = moves.rows(sl)
     lim = {k: [_at(a, sl, row) for a in v] if isinstance(v, list) else _at(v, sl, row) for k, v in lim.items()}
     axes_d = moves.end[sl] - moves.start[sl]
     dist_mm = [np.ascontiguousarray(axes_d[:, a]) for a in range(4)]  # X, Y, Z, E columns
@@ -343,7 +343,7 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
             return np.ascontiguousarray(value, dtype=float).reshape(-1)
 
         millimeters, nominal_speed, speed_per_mm, acceleration = kernels.marlin_blocks(
-            *dist_mm, np.ascontiguousarray(moves.speed_v[sl]), *map(each, lim["max_feedrate"]),
+            *dist_mm, np.ascontiguousarray(moves.speeds(sl)), *map(each, lim["max_feedrate"]),
             *map(each, lim["max_acceleration"]), *(each(lim[k]) for k in ("min_feedrate", "min_travel_feedrate",
                                                                         "acceleration", "travel_acceleration",
                                                                         "retract_acceleration")),
@@ -351,7 +351,7 @@ def _populate_blocks(moves: PlannerMoves, lim: dict, rest_before: np.ndarray, co
         inverse_millimeters = 1.0 / millimeters
     else:
         millimeters, inverse_millimeters, nominal_speed, speed_per_mm, acceleration = _block_speeds(
-            dist_mm, xyz_moves, esteps, moves.speed_v[sl], lim, config)
+            dist_mm, xyz_moves, esteps, moves.speeds(sl), lim, config)
     _junctions(dist_mm, esteps, millimeters, inverse_millimeters, nominal_speed, speed_per_mm, acceleration, lim,
                rest_before[sl], config, kernels, lo - first, lo, hi, out)
 

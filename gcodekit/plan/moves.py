@@ -62,8 +62,38 @@ class MoveSource:
         return _narrow(self.command[waypoint], self.n_rows)
 
 
-@dataclass
-class PlannerMoves:
+class _SpeedsAndRows:
+    """Each move's requested speed and command row: stored, or read again from the moves' :class:`MoveSource`
+    (``source``) at their waypoints, bit for bit, on each access."""
+
+    _speed_v: np.ndarray | None
+    _row: np.ndarray | None
+    source: MoveSource | None
+    waypoint: np.ndarray
+
+    @property
+    def speed_v(self) -> np.ndarray:
+        return self.speeds(slice(None))
+
+    @property
+    def row(self) -> np.ndarray:
+        return self.rows(slice(None))
+
+    @property
+    def read_from_source(self) -> bool:
+        """Whether the speeds and rows are read from :attr:`source` (not stored)."""
+        return self._speed_v is None
+
+    def speeds(self, sel: slice | np.ndarray) -> np.ndarray:
+        """The requested speeds of the moves ``sel``, without reading every move's."""
+        return self._speed_v[sel] if self._speed_v is not None else self.source.speed_v(self.waypoint[sel])
+
+    def rows(self, sel: slice | np.ndarray) -> np.ndarray:
+        """The command rows of the moves ``sel``."""
+        return self._row[sel] if self._row is not None else self.source.row(self.waypoint[sel])
+
+
+class PlannerMoves(_SpeedsAndRows):
     """Straight moves in the order the firmware receives them.
 
     Attributes
@@ -80,23 +110,24 @@ class PlannerMoves:
         Waypoint each move belongs to (several for a segmented arc).
     source : MoveSource, optional
         Where ``speed_v`` and ``row`` were read (moves straight from
-        :func:`firmware_moves`; moves changed since have none).
+        :func:`firmware_moves`; moves changed since have none).  Given
+        without ``speed_v`` and ``row``, those are read from it on each
+        access, and :meth:`speeds` and :meth:`rows` read a block of moves'
+        (Marlin's planner, which never holds every move's).
     """
 
-    start: np.ndarray
-    end: np.ndarray
-    speed_v: np.ndarray
-    row: np.ndarray
-    waypoint: np.ndarray
-    source: MoveSource | None = None
-
-    def __post_init__(self):
-        if self.source is not None:  # what the source gives: changing them would part them from it
-            for values in (self.speed_v, self.row):
+    def __init__(self, start: np.ndarray, end: np.ndarray, speed_v: np.ndarray | None, row: np.ndarray | None,
+                 waypoint: np.ndarray, source: MoveSource | None = None):
+        if source is None and (speed_v is None or row is None):
+            raise ValueError("moves need their speeds and rows, or the source to read them from")
+        for values in (speed_v, row) if source is not None else ():
+            if values is not None:  # what the source gives: changing them would part them from it
                 values.flags.writeable = False
+        self.start, self.end, self.waypoint, self.source = start, end, waypoint, source
+        self._speed_v, self._row = speed_v, row
 
     def __len__(self) -> int:
-        return int(self.row.size)
+        return int(self.waypoint.size)
 
     @property
     def axes_d(self) -> np.ndarray:
@@ -108,7 +139,7 @@ class PlannerMoves:
             start, end = self.start[keep], self.end[keep]
         else:
             start, end = np.asarray(self.start)[keep], np.asarray(self.end)[keep]
-        return PlannerMoves(start, end, self.speed_v[keep], self.row[keep], self.waypoint[keep])
+        return PlannerMoves(start, end, self.speeds(keep), self.rows(keep), self.waypoint[keep])
 
     def planned(self, length_d: np.ndarray | None = None) -> "PlannedMoves":
         """What an operation keeps after planning: no end points, just each move's length (``length_d``, the
@@ -123,7 +154,7 @@ class PlannerMoves:
         return PlannedMoves(self.speed_v, self.row, self.waypoint, length_d)
 
 
-class PlannedMoves:
+class PlannedMoves(_SpeedsAndRows):
     """The planned moves an operation keeps (``op.plan``), a quarter of :class:`PlannerMoves`' size.
 
     Attributes
@@ -145,18 +176,6 @@ class PlannedMoves:
             raise ValueError("planned moves need their speeds and rows, or the source to read them from")
         self._speed_v, self._row, self.source = speed_v, row, source
         self.waypoint, self.length_d = waypoint, length_d
-
-    @property
-    def speed_v(self) -> np.ndarray:
-        return self.speeds(slice(None))
-
-    @property
-    def row(self) -> np.ndarray:
-        return self._row if self._row is not None else self.source.row(self.waypoint)
-
-    def speeds(self, sel: slice | np.ndarray) -> np.ndarray:
-        """The requested speeds of the moves ``sel``, without reading every move's."""
-        return self._speed_v[sel] if self._speed_v is not None else self.source.speed_v(self.waypoint[sel])
 
     def __len__(self) -> int:
         return int(self.waypoint.size)
@@ -301,7 +320,7 @@ def settings_in_force(op: "EmulatedProgram", moves: PlannerMoves, rows: np.ndarr
     given = ~np.isnan(values)
     if not given.any():
         return float(initial)
-    if len(moves) and rows[given][-1] < moves.row[0]:  # set once before the first move: one value
+    if len(moves) and rows[given][-1] < moves.rows(slice(0, 1))[0]:  # set once before the first move: one value
         return float(values[given][-1])
     per_move = in_force(moves, rows[given], values[given], initial)
     return float(per_move[0]) if per_move.min() == per_move.max() else per_move
@@ -390,10 +409,10 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     rapids_at_feed = op.machine.rapids_at_feed(op.flavor is None or op.flavor.rapid_is_feed)
     source = MoveSource(w["feed"], rows, w["motion"], None if rapids_at_feed else op.machine.rapid_feed / 60.0,
                         speed_factor, len(op.table))
-    speed = source.speed_v(idx)
     is_arc = w["motion"][idx] >= 3
-    rows = source.row(idx)
     segmenting = arc_segments is not None and bool(is_arc.any())
+    # gathered, the planner reads the speeds and rows a block at a time too: two arrays fewer at its peak
+    speed, rows = (None, None) if gathered and not segmenting else (source.speed_v(idx), source.row(idx))
     if gathered or compiled is None:  # the points from the waypoint columns: gathered when asked, else stored
         ends = MoveEnds((w["x"], w["y"], w["z"], RunningSum(w["de"], e)), idx, is_chained)
         start, end = (ends.start, ends.end) if gathered and not segmenting else ends.arrays()

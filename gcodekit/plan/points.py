@@ -17,29 +17,59 @@ __all__ = ["MoveEnds", "RunningSum", "chained"]
 
 
 class RunningSum:
-    """A column's running sum (``np.cumsum(deltas)``, the extruder position from each waypoint's ``de``),
-    made when first read.
+    """A column's running sum (``np.cumsum(deltas)``, the extruder position from each waypoint's ``de``).
 
-    Indexed like the array it stands for.  A compiled loop that walks the
-    waypoints in order sums :attr:`deltas` itself (Klipper's set-up), so
-    the 8 bytes per waypoint of the sums are never held at its peak.
+    Indexed like the array it stands for.  Read in order, a block of
+    waypoints at a time (Marlin's planner), it sums only as far as asked and
+    keeps only the stretch the last two reads covered; read out of order,
+    it makes every sum once.  Either way the sums are ``np.cumsum``'s to the
+    last bit: each stretch is summed on from the sum before it, in the same
+    order.  A compiled loop that walks the waypoints in order sums
+    :attr:`deltas` itself (Klipper's set-up).
     """
 
     def __init__(self, deltas: np.ndarray, sums: np.ndarray | None = None):
         self.deltas = deltas
         self._sums = sums
+        self._window = np.empty(0)  # the sums of waypoints _first .. _first + len(_window) - 1
+        self._first = 0
+        self._last_read = 0  # the lowest waypoint of the read before
 
     @property
     def sums(self) -> np.ndarray:
         if self._sums is None:
             self._sums = np.cumsum(self.deltas)
+            self._window = np.empty(0)
         return self._sums
 
     def __len__(self) -> int:
         return int(np.shape(self.deltas)[0])
 
     def __getitem__(self, index) -> np.ndarray:
-        return self.sums[index]
+        index = np.asarray(index)
+        if self._sums is not None or index.dtype == bool or index.ndim != 1 or index.size == 0:
+            return self.sums[index]
+        lo, hi = int(index.min()), int(index.max()) + 1
+        if lo < self._first or lo < 0:
+            return self.sums[index]
+        self._extend(hi)
+        keep = min(lo, self._last_read)
+        self._last_read = lo
+        if keep > self._first:
+            self._window = self._window[keep - self._first:].copy()
+            self._first = keep
+        return self._window[index - self._first]
+
+    def _extend(self, hi: int) -> None:
+        """Sum on to waypoint ``hi - 1``, from the last sum held (np.cumsum adds in order)."""
+        end = self._first + self._window.size
+        if hi <= end:
+            return
+        if self._window.size:
+            more = np.cumsum(np.r_[self._window[-1], self.deltas[end:hi]])[1:]
+        else:  # nothing summed yet
+            more = np.cumsum(self.deltas[:hi])
+        self._window = np.concatenate([self._window, more])
 
     def __array__(self, dtype=None, copy=None) -> np.ndarray:
         return self.sums if dtype is None else self.sums.astype(dtype)
