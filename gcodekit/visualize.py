@@ -248,13 +248,25 @@ def add_legend(fig: "Figure", color: Coloring, path: Toolpath, segments: np.ndar
         fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(rect[0] - 0.04, rect[1] + rect[3] + 0.05),
                    fontsize=fontsize, frameon=False, title=color.title, title_fontsize=fontsize + 1)
         return
+    if vmax <= vmin:  # one value: a swatch that says so, not a scale over a range nothing has
+        fig.legend(handles=[_one_value_patch(color, vmin)], loc="upper right",  # its title can be long
+                   bbox_to_anchor=(0.99, rect[1] + rect[3] + 0.05), fontsize=fontsize, frameon=False,
+                   title=color.title, title_fontsize=fontsize + 1)
+        return
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
 
     cax = fig.add_axes(list(rect))
-    bar = fig.colorbar(ScalarMappable(Normalize(vmin, vmax if vmax > vmin else vmin + 1), color.cmap()), cax=cax)
+    bar = fig.colorbar(ScalarMappable(Normalize(vmin, vmax), color.cmap()), cax=cax)
     bar.set_label(color.title, fontsize=fontsize + 1)
     bar.ax.tick_params(labelsize=fontsize)
+
+
+def _one_value_patch(color: Coloring, value: float):
+    """The legend entry of a colouring whose work moves all have ``value``, in the colour they are drawn in."""
+    import matplotlib.patches as mpatches
+
+    return mpatches.Patch(color=color.rgb(np.array([value]), value, value)[0], label=f"every move: {value:g}")
 
 
 def plot_layer(source: "Operation | AdditivePart", layer: int, *, ax: "Axes | None" = None,
@@ -302,12 +314,14 @@ def plot_layer(source: "Operation | AdditivePart", layer: int, *, ax: "Axes | No
         handles = [mlines.Line2D([], [], color=color.rgb(np.array([k]), 0, 1)[0], label=color.categories[k])
                    for k in used]
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False)
+    elif vmax <= vmin:
+        ax.legend(handles=[_one_value_patch(color, vmin)], loc="upper left", bbox_to_anchor=(1.01, 1.0),
+                  fontsize="small", frameon=False, title=color.title)
     else:
         from matplotlib.cm import ScalarMappable
         from matplotlib.colors import Normalize
 
-        ax.figure.colorbar(ScalarMappable(Normalize(vmin, vmax if vmax > vmin else vmin + 1), color.cmap()), ax=ax,
-                           label=color.title)
+        ax.figure.colorbar(ScalarMappable(Normalize(vmin, vmax), color.cmap()), ax=ax, label=color.title)
     ax.autoscale()
     ax.set_aspect("equal")
     ax.set_xlabel("X (mm)")

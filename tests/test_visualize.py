@@ -92,3 +92,36 @@ def test_import_does_not_load_the_plotting_libraries():
 
     code = "import sys, gcodekit.visualize; print(any(m in sys.modules for m in ('pyvista', 'vtk', 'matplotlib')))"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
+
+
+def test_one_value_gets_a_swatch_not_a_scale_over_an_invented_range():
+    # every cut at F500: the legend says so, in the colour the moves are drawn in; two feeds get a colour bar
+    import matplotlib
+    import matplotlib.colors
+
+    matplotlib.use("Agg")
+    from gcodekit.report import figures
+
+    one = gcodekit.gcode_to_operation("G21 G90 G0 X0 Y0 Z1\nG1 Z-1 F500\nG1 X10\nG1 Y10\nM2\n", "linuxcnc")
+    drawing = figures.toolpath_drawing(one)
+    fig = figures.toolpath_iso(drawing)
+    (legend,) = fig.legends
+    assert [t.get_text() for t in legend.get_texts()] == ["every move: 500"]
+    assert legend.get_title().get_text() == drawing.color.title
+    swatch = legend.legend_handles[0].get_facecolor()[:3]
+    np.testing.assert_allclose(swatch, drawing.color.rgb(np.array([500.0]), 500.0, 500.0)[0], atol=1e-6)
+    assert len(fig.axes) == 1  # the picture alone: no colour bar axes
+    two = gcodekit.gcode_to_operation("G21 G90 G0 X0 Y0 Z1\nG1 Z-1 F500\nG1 X10\nG1 Y10 F800\nM2\n", "linuxcnc")
+    fig = figures.toolpath_iso(figures.toolpath_drawing(two))
+    assert not fig.legends and len(fig.axes) == 2
+    assert fig.axes[1].get_ylim() == (500.0, 800.0)
+
+
+def test_a_layer_of_one_speed_gets_a_swatch_too():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    op = gcodekit.gcode_to_operation("G21 G90 M83\nG1 Z0.2 F1200\nG1 X10 E1\nG1 Y10 E1\nG1 X0 E1\n", "marlin")
+    ax = visualize.plot_layer(op, 0, scalars="feed")
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["every move: 1200"]
+    assert len(ax.figure.axes) == 1
