@@ -50,8 +50,40 @@ CHUNK_BYTES = 256 << 10  # small chunks keep the per-chunk arrays (about 60 byte
 #: Longer lines are reported and skipped: no real controller accepts them,
 #: and a binary file without newlines must not be read as one huge block.
 MAX_LINE_LENGTH = 65536
-#: A first chunk with at least this share of NUL bytes is binary data, not text.
+#: A first chunk with at least this share of NUL bytes, and at least BINARY_NULS of them, is binary data, not
+#: text (fewer, in a short program, are read as the characters they are: comments keep them, words report them).
 BINARY_NUL_SHARE = 0.1
+BINARY_NULS = 8
+
+def binary_kind(data: bytes) -> str | None:
+    """What a file's first bytes hold when they are not program text, or None for text.
+
+    NUL padding at the end is not counted.  NUL bytes at every other place
+    are UTF-16 text; a tenth or more of NUL bytes (and at least
+    :data:`BINARY_NULS`) is other binary data.
+    """
+    body = data.rstrip(b"\x00")
+    nuls = body.count(b"\x00")
+    if nuls == 0:
+        return None
+    half = len(body) // 2
+    for zeros, chars in ((body[1::2], body[0::2]), (body[0::2], body[1::2])):  # little-endian, big-endian
+        if half >= 2 and zeros.count(b"\x00") >= 0.9 * half and _printable_share(chars) >= 0.9:
+            return "UTF-16 text without its byte-order mark (save it as UTF-8, or with the mark)"
+    if nuls >= BINARY_NULS and nuls >= BINARY_NUL_SHARE * len(body):
+        return "binary data (NUL bytes)"
+    return None
+
+
+def _printable_share(data: bytes) -> float:
+    """The share of ``data`` that is printable ASCII, tab or a line end."""
+    if not data:
+        return 0.0
+    return 1.0 - len(data.translate(None, _PRINTABLE)) / len(data)  # what is left once the printable are deleted
+
+
+_PRINTABLE = bytes(range(32, 127)) + b"\t\n\r"
+
 
 _ARCHIVES = (  # magic number, name, opener
     (b"\x1f\x8b", "gzip", lambda f: gzip.GzipFile(fileobj=f)),
@@ -214,9 +246,9 @@ class _LineSplitter:
                 return
             if first:
                 first = False
-                if data.count(b"\x00") >= BINARY_NUL_SHARE * len(data):
-                    self._report("the file holds binary data (NUL bytes), not program text; nothing read "
-                                 "(UTF-16 text needs its byte-order mark)")
+                binary = binary_kind(data)
+                if binary:
+                    self._report(f"the file holds {binary}, not program text; nothing read")
                     return
                 if b"\n" not in data and b"\r" in data:
                     self.cr_only = True
@@ -256,5 +288,9 @@ class _LineSplitter:
             self.lines += data.count(b"\n", 0, cut)
             yield data[:cut]
         if rest and not self.damaged:
+            if not rest.strip(b"\x00"):  # a firmware reads up to the first NUL: such a last line is empty
+                self._report(f"the file ends in {len(rest)} NUL bytes after its last line (padding, as an SD card "
+                             "or a file transfer can leave); ignored", severity="info")
+                return
             self.lines += 1
             yield rest + b"\n"
