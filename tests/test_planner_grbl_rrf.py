@@ -321,3 +321,14 @@ def test_rrf_plans_moves_at_f0_at_the_minimum_movement_speed():
     z3 = trapezoid_time(3.0, v, c.max_acceleration_z)
     assert v == 0.5 and x13 == pytest.approx(6.0 + 0.5 / 1500 - 0.25 / 3000 / 0.5, rel=1e-12)
     np.testing.assert_allclose(op.waypoints["time"][2:], [x13, z3], rtol=1e-9)
+
+
+def test_rrf_moves_before_any_f_at_its_boot_feed():
+    """RepRapFirmware starts at ``DefaultFeedRate``, 3000 mm/min (Configuration.h; Marlin and Klipper start at
+    1500): a long move before any F cruises at 50 mm/s, the next at its own F."""
+    op = gcodekit.gcode_to_operation("G1 X200\nG1 X0 F1200\n", "reprapfirmware")
+    moves, result = op.plan
+    assert moves.speed_v.tolist() == [50.0, 20.0]
+    assert result.cruise_v.tolist() == [50.0, 20.0]
+    marlin = gcodekit.gcode_to_operation("G1 X200\n", "marlin")
+    assert marlin.plan[0].speed_v.tolist() == [25.0]
