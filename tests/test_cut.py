@@ -195,3 +195,31 @@ def test_part_mesh_is_closed_and_holds_the_remaining_volume(tmp_path):
     image = result.picture(tmp_path / "part.png", window_size=(400, 300))
     assert image.shape == (300, 400, 3) and (tmp_path / "part.png").exists()
     assert len(np.unique(image.reshape(-1, 3), axis=0)) > 20  # shaded, not blank
+
+
+def test_coarse_picture_grid_takes_each_blocks_lowest_top():
+    from gcodekit.cut.result import _block_min
+
+    rng = np.random.default_rng(3)
+    for shape, step in (((7, 5), 2), ((9, 9), 3), ((10, 4), 4), ((5, 13), 6)):
+        a = rng.normal(size=shape)
+        ny, nx = -(-shape[0] // step), -(-shape[1] // step)  # blocks at the far edges are smaller
+        expected = np.array([[a[i * step:(i + 1) * step, j * step:(j + 1) * step].min() for j in range(nx)]
+                             for i in range(ny)])
+        np.testing.assert_array_equal(_block_min(a, step), expected)
+
+
+def test_a_stock_millions_of_cells_long_and_two_wide_is_pictured():
+    # found by explore.sh (seed 4213612503, a damaged archive whose numbers ran together): a Y of 8e11 mm
+    # made the 4 M-cell grid 3.6 M x 2 cells, and its picture padded the 2 columns to the coarsening step,
+    # 11,275: 303 GiB asked for
+    pytest.importorskip("pyvista")
+    from gcodekit.cut.result import PICTURE_CELLS, part_mesh
+
+    op = _op("G21 G90\nT1 M6\nG0 X0 Y0 Z1\nG1 Z-1 F100\nG1 Y800000000000\n")
+    result = CutSimulation(op, tools=FLAT6, max_cells=4_000_000).run()  # the report's grid: coarsened to fit
+    # the grid coarsened to fit: one cell across the 6 mm cut, the length in at most 4 M cells
+    assert result.top.shape[1] == 1 and result.top.size <= 4_000_000
+    mesh = part_mesh(result.stock, result.top, PICTURE_CELLS)
+    assert mesh.n_points <= 2 * (PICTURE_CELLS + 1) * 2
+    assert result.picture(window_size=(200, 150)).shape == (150, 200, 3)

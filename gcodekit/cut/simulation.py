@@ -189,7 +189,9 @@ class CutSimulation:
         ends = np.r_[p.owner[1:] != p.owner[:-1], True]
         z0, z1 = float(both[:, 2].min()) - FLOOR_MARGIN, float(p.p1[ends, 2].max())
         if not explicit and (x1 - x0) * (y1 - y0) / resolution**2 > self.max_cells:
-            coarser = math.sqrt((x1 - x0) * (y1 - y0) / self.max_cells)
+            # cells as square as the area allows, but no fewer than one across a narrow side: the long side
+            # alone must then fit (a 6 mm wide cut 8e11 mm long)
+            coarser = max(math.sqrt((x1 - x0) * (y1 - y0) / self.max_cells), max(x1 - x0, y1 - y0) / self.max_cells)
             self.notes.append(Diagnostic(self.op.file, 0, 0, "info",
                                          f"a {resolution:g} mm grid over {x1 - x0:g} x {y1 - y0:g} mm would pass "
                                          f"{self.max_cells:,} cells: cut at {coarser:.3g} mm"))
