@@ -332,3 +332,13 @@ def test_rrf_moves_before_any_f_at_its_boot_feed():
     assert result.cruise_v.tolist() == [50.0, 20.0]
     marlin = gcodekit.gcode_to_operation("G1 X200\n", "marlin")
     assert marlin.plan[0].speed_v.tolist() == [25.0]
+
+
+def test_rrf_scales_by_m220_only_moves_that_name_an_axis():
+    """RepRapFirmware's ``applyM220M221`` needs an axis named on the move (``GCodes::LoadFeedrateFromGCode``): a
+    retraction keeps its F.  Marlin and Klipper scale every move."""
+    text = "M220 S50\nG1 X100 F6000\nG1 E-2 F2400\nG0 X0 F6000\n"
+    rrf = gcodekit.gcode_to_operation(text, "reprapfirmware")
+    assert rrf.plan[0].speed_v.tolist() == [50.0, 40.0, 50.0]
+    for machine in ("marlin", "klipper"):
+        assert gcodekit.gcode_to_operation(text, machine).plan[0].speed_v.tolist() == [50.0, 20.0, 50.0]

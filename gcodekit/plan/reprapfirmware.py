@@ -206,6 +206,19 @@ def _program_limits(op: "EmulatedProgram", moves: PlannerMoves, config: RrfConfi
     return limits
 
 
+def _speed_factor(op: "EmulatedProgram") -> np.ndarray | None:
+    """M220's factor per waypoint as RepRapFirmware applies it: to moves that name an axis, not to
+    extruder-only ones such as retractions (``applyM220M221`` in ``GCodes::LoadFeedrateFromGCode``)."""
+    factor = speed_factor(op)
+    if factor is None:
+        return None
+    rows = op.waypoints["command"]
+    names_an_axis = np.zeros(np.shape(rows), bool)
+    for letter in "XYZUVWABC":
+        names_an_axis |= ~np.isnan(op.table.param_at(letter, rows))
+    return np.where(names_an_axis, factor, 1.0)
+
+
 def plan(op: "EmulatedProgram", config: RrfConfig) -> tuple[PlannerMoves, PlanResult]:
     """Plan an emulated operation as RepRapFirmware 3 would; one result per firmware move.
 
@@ -220,7 +233,7 @@ def plan(op: "EmulatedProgram", config: RrfConfig) -> tuple[PlannerMoves, PlanRe
     >>> round(float(result.duration_t[0]), 3)
     0.54
     """
-    factor = speed_factor(op)
+    factor = _speed_factor(op)
     moves = firmware_moves(op, factor, lambda travel, angle, radius, speed_v: arc_segments(
         travel, angle, radius, speed_v, config))
     n = len(moves)
