@@ -155,3 +155,15 @@ def test_rotated_work_systems_move_alike_at_every_stage():
         np.testing.assert_allclose(path_of(again), reference, atol=1e-3, equal_nan=True, err_msg=f"stage {k}")
     code = [line for line in t.stage(2).splitlines() if not line.startswith("(")]
     assert not [line for line in code if "G10" in line or "G81" in line]  # the rotation and its cycles resolved
+
+
+@pytest.mark.parametrize("path", PROGRAMS[:12], ids=lambda p: p.name)
+def test_summary_counts_what_each_stage_writes(path):
+    # counted in one pass over the commands for all stages; here from each stage's text, line by line
+    t = Transpiler(operation(path))
+    expected = []
+    for k in STAGES:
+        lines = t.stage(k).splitlines()[1:]
+        moves = sum(1 for line in lines if any(f" G{g} " in f" {line} " for g in (0, 1, 2, 3)))
+        expected.append((k, len(lines), moves))
+    assert [(s["stage"], s["lines"], s["moves"]) for s in t.summary()] == expected

@@ -115,6 +115,10 @@ class Transpiler:
         flavor = self.op.flavor
         #: mm per output length unit from stage 1 on: the machine's own units
         self.unit = MM_PER_INCH if flavor is not None and flavor.units == "inch" else 1.0
+        # each command row's waypoints, w["command"] being sorted: rows[r]..rows[r + 1] - 1, looked up once
+        self._first_waypoint = np.searchsorted(w["command"], np.arange(len(self.op.table) + 1)) \
+            if "command" in w else None
+        self._command_of = (-1, None)  # the last row's Command: the stages of one row share it
 
     # -- public -----------------------------------------------------------------
 
@@ -124,17 +128,25 @@ class Transpiler:
             from ..errors import ConfigError
 
             raise ConfigError(f"stage must be one of 0-6, not {k!r}")
-        frame = "absolute machine coordinates" if k >= 4 else "machine coordinates" if k >= 2 else "program coordinates"
-        unit_name = "inch" if self.unit == MM_PER_INCH else "mm"
-        lines = [f"(gcodekit transpile stage {k}: machine units {unit_name}, {frame})" if k >= 1 else
-                 "(gcodekit transpile stage 0: subprograms, loops and macros expanded)"]
-        if k >= 1:  # the output says its units, so any controller reads it the same
-            lines.append("G20" if self.unit == MM_PER_INCH else "G21")
+        lines = [self._title(k)] + self._head(k)
         for row in range(len(self.op.table)):
             lines.extend(self._row(row, k))
+        return "\n".join(lines + self._tail()) + "\n"
+
+    def _title(self, k: int) -> str:
+        frame = "absolute machine coordinates" if k >= 4 else "machine coordinates" if k >= 2 else "program coordinates"
+        unit_name = "inch" if self.unit == MM_PER_INCH else "mm"
+        return (f"(gcodekit transpile stage {k}: machine units {unit_name}, {frame})" if k >= 1 else
+                "(gcodekit transpile stage 0: subprograms, loops and macros expanded)")
+
+    def _head(self, k: int) -> list[str]:
+        """The lines after the title: from stage 1 the output says its units, so any controller reads it alike."""
+        return ["G20" if self.unit == MM_PER_INCH else "G21"] if k >= 1 else []
+
+    def _tail(self) -> list[str]:
         if not (self.op.table.name == NAME_ID["program_end"]).any():
-            lines.append("M2 (the source ends without M2 or M30)")  # rs274 refuses a file with no end
-        return "\n".join(lines) + "\n"
+            return ["M2 (the source ends without M2 or M30)"]  # rs274 refuses a file with no end
+        return []
 
     def commands(self, k: int):
         """Stage ``k`` read back as typed commands (its text is plain RS274NGC)."""
@@ -145,13 +157,22 @@ class Transpiler:
         return Operation(GcodeParser("rs274ngc").parse(read_text(self.stage(k), "rs274ngc"))).commands
 
     def summary(self) -> list[dict]:
-        """Per stage: its name and how many lines and motion lines it has."""
-        out = []
-        for k in STAGES:
-            text = self.stage(k).splitlines()[1:]
-            moves = sum(1 for line in text if any(f" G{g} " in f" {line} " for g in (0, 1, 2, 3)))
-            out.append({"stage": k, "name": STAGE_NAMES[k], "lines": len(text), "moves": moves})
-        return out
+        """Per stage: its name and how many lines and motion lines it has (below the title line).
+
+        Counted in one pass over the commands for every stage, without
+        keeping any stage's text.
+        """
+        def is_move(line: str) -> bool:
+            return any(f" G{g} " in f" {line} " for g in (0, 1, 2, 3))
+
+        lines = {k: self._head(k) + self._tail() for k in STAGES}
+        counts = {k: [len(lines[k]), sum(map(is_move, lines[k]))] for k in STAGES}
+        for row in range(len(self.op.table)):
+            for k in STAGES:
+                out = self._row(row, k)
+                counts[k][0] += len(out)
+                counts[k][1] += sum(map(is_move, out))
+        return [{"stage": k, "name": STAGE_NAMES[k], "lines": counts[k][0], "moves": counts[k][1]} for k in STAGES]
 
     # -- one command --------------------------------------------------------------
 
@@ -159,7 +180,7 @@ class Transpiler:
         t = self.op.table
         name = NAMES[int(t.name[row])]
         kind = Kind(int(t.kind[row]))
-        cmd = t.command(row)
+        cmd = self._command(row)
         n = f"N{cmd.line}"
         comment = self._comment(row, cmd, k)
         if kind == Kind.COMMENT:
@@ -178,13 +199,15 @@ class Transpiler:
         words = self._words(row, cmd, k)
         return [f"{n} {words}{comment}".rstrip()]
 
+    def _command(self, row: int):
+        if self._command_of[0] != row:
+            self._command_of = (row, self.op.table.command(row))
+        return self._command_of[1]
+
     def _waypoints(self, row: int) -> np.ndarray:
-        w = self.op.waypoints
-        if "command" not in w:
+        if self._first_waypoint is None:
             return np.array([row])
-        cmd = w["command"]
-        lo, hi = np.searchsorted(cmd, [row, row + 1])
-        return np.arange(lo, hi)
+        return np.arange(self._first_waypoint[row], self._first_waypoint[row + 1])
 
     def _words(self, row: int, cmd, k: int) -> str:
         """The command's own words, with units (stage 1+) and offsets (2+) resolved."""
@@ -240,7 +263,7 @@ class Transpiler:
         n = f"N{int(t.line[row])}"
         cycle = int(t.motion[row]) == MOTION_CYCLE or NAMES[int(t.name[row])] in CYCLE_NAMES
         if cycle and k < 6 and not self._rotated_rows[row]:
-            return [f"{n} {self._words(row, t.command(row), k)}{comment}"]
+            return [f"{n} {self._words(row, self._command(row), k)}{comment}"]
         fmt = lambda v: format_number(v, self.precision)  # noqa: E731
         increments = k < 4 and self._incremental(row)
         absolute_centre = k < 4 and bool(self._arc_absolute_rows[row])  # G90.1 still in force
@@ -268,7 +291,7 @@ class Transpiler:
                 lines.append(f"{n} {self._arc(p, motion, absolute_centre)} {coords}{feed}")
         if lines:
             lines[-1] += comment
-        dwell = t.command(row).params.get("P") if cycle and NAMES[int(t.name[row])] in (
+        dwell = self._command(row).params.get("P") if cycle and NAMES[int(t.name[row])] in (
             "cycle_drill_dwell", "cycle_bore_stop", "cycle_bore_dwell") else None
         if dwell is not None and k >= 6 and len(lines) >= 2:
             lines.insert(len(lines) - 1, f"{n} G4 P{fmt(dwell)}")
@@ -301,7 +324,7 @@ class Transpiler:
         """
         w = self.op.waypoints
         points = self._waypoints(row)
-        cmd = self.op.table.command(row)
+        cmd = self._command(row)
         if self._incremental(row):
             return np.zeros(3)
         scale = MM_PER_INCH if w["units"][points[-1]] == 1 else 1.0
