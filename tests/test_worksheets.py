@@ -658,10 +658,13 @@ def test_handed_in_pages_show_their_pictures_offline_in_chromium(handed_in):
             page.wait_for_load_state("load")
             sizes = page.evaluate("[...document.images].map(i => [i.naturalWidth, i.naturalHeight])")
             assert sizes and all(w > 100 and h > 100 for w, h in sizes), (name, sizes)
-            # looked at as a picture: the first widget's picture as the page shows it holds a drawing, not a blank
+            # looked at as a picture: the first widget's picture as the page shows it holds a drawing below its
+            # title and legend (the top eighth: alone they darken about 0.5 % of the pixels; one cut at one feed
+            # is a few lines, 0.4 % more), not a blank
             shot = page.locator("img").first.screenshot()
             pixels = np.asarray(Image.open(io.BytesIO(shot)).convert("L"), float)
-            assert pixels.std() > 10 and (pixels < 250).mean() > 0.01, name
+            drawing = pixels[pixels.shape[0] // 8:]
+            assert pixels.std() > 10 and (drawing < 250).mean() > 0.002, (name, (drawing < 250).mean())
         assert page.console_errors == []
 
 
