@@ -239,6 +239,13 @@ def test_planted_markup_is_text_and_the_canvas_agrees(lab):
     assert page.locator("#gk-planted").count() == 0
     assert legend.locator("img, b").count() == 0
     assert [legend.locator(".gk-category").nth(k).inner_text() for k in range(2)] == sorted(PLANTED)
+    # coloured by feed, every deposit at F1800: a swatch that says so, as the pictures say it (no scale)
+    area.locator("select").first.select_option("feed")
+    legend.locator(".gk-one-value").wait_for(timeout=30_000)
+    assert legend.locator(".gk-one-value").inner_text() == "every move: 1800"
+    area.locator("select").first.select_option("feature")
+    legend.locator(".gk-category").nth(1).wait_for(timeout=30_000)
+    page.wait_for_timeout(500)
     code = area.locator(".gcodekit-code")
     assert "<img src=x onerror=window.gkPlanted=2>" in code.inner_text() and code.locator("img").count() == 0
     assert page.console_errors == []  # an <img src=x> made would have failed to load

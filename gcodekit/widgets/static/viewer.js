@@ -299,6 +299,17 @@ function render({ model, el }) {
       legend.replaceChildren(...nodes);
       return;
     }
+    if (vmin === vmax) {
+      // one value on screen: a swatch that says so (the shader draws a zero span at the scale's low end)
+      const swatch = element("span", "display:inline-block;width:10px;height:10px;margin-right:4px");
+      swatch.style.background = hex(p[0], p[1], p[2]);
+      const row = element("div");
+      row.className = "gk-one-value";
+      row.append(swatch, element("span", "", `every move: ${Number(vmin.toPrecision(6))}`));
+      nodes.push(row);
+      legend.replaceChildren(...nodes);
+      return;
+    }
     const stops = [];
     for (let i = 0; i <= 8; i++) {
       const j = Math.round((i / 8) * 255) * 3;
