@@ -350,7 +350,7 @@ def _slicer_line(r: dict[str, Any]) -> str:
 
     theirs = r["slicer"]
     name = " ".join(v for v in (theirs["slicer"], theirs["version"]) if v) or "slicer"
-    shown = {"time": lambda v: _duration(v), "filament": lambda v: f"{v:.1f} mm",
+    shown = {"time": _duration, "model time": _duration, "filament": lambda v: f"{v:.1f} mm",
              "filament volume": lambda v: f"{v:.3f} cm3", "layers": str}
     parts = [f"{row['figure']} {shown[row['figure']](row['slicer'])}"
              + (f" (gcodekit {100 * row['difference']:+.1f} %)" if row["difference"] else " (gcodekit the same)")

@@ -351,6 +351,12 @@ def test_figures_of_bambu_studio_and_creality_print_headers():
     # "; model printing time: 8m 57s; total estimated time: 15m 42s" and "; total layer number: 92"
     assert (f.slicer, f.version, f.time_s, f.layers) == ("BambuStudio", "01.07.06.92", 15 * 60 + 42, 92)
     assert f.filament_mm is None  # Bambu Studio 1.7 writes no filament figure
+    assert f.time_model_s == 8 * 60 + 57  # "model printing time": the model alone, without the printer's start-up
+    rows = {r["figure"]: r for r in compare(gcodekit.gcode_to_operation(
+        shared_file("realworld", "bambustudio_1.7.6_x1_cube.gcode")).summary())}
+    ours = rows["time"]["gcodekit"]
+    assert (rows["time"]["slicer"], rows["model time"]["slicer"], rows["model time"]["gcodekit"]) == (942, 537, ours)
+    assert rows["model time"]["difference"] == pytest.approx((ours - 537) / 537)
     creality = gcodekit.gcode_to_operation(shared_file("realworld", "crealityprint_5.1.4.gcode"), plan=False)
     f = creality.slicer_figures()
     # "; filament cost = 0.65; total filament used [g] = 32.46" is two settings on one line

@@ -146,6 +146,10 @@ class SlicerFigures:
         ``"PrusaSlicer"``, ``"CuraEngine"``, ``"OrcaSlicer"``, ... and its version.
     time_s, time_silent_s : float or None
         Estimated print time, s, in normal and silent mode.
+    time_model_s : float or None
+        The time of the model alone, s, where the total also counts the
+        printer's own calibration and heating (Bambu Studio's ``model
+        printing time``).
     filament_mm, filament_cm3, filament_g, filament_cost : float or None
         Filament used, summed over the extruders.
     layers : int or None
@@ -165,6 +169,7 @@ class SlicerFigures:
     version: str | None = None
     time_s: float | None = None
     time_silent_s: float | None = None
+    time_model_s: float | None = None
     filament_mm: float | None = None
     filament_cm3: float | None = None
     filament_g: float | None = None
@@ -184,9 +189,9 @@ class SlicerFigures:
 
     def as_dict(self) -> dict[str, Any]:
         """The figures as plain values (``info --json``'s ``slicer`` key); settings are left out."""
-        out = {k: getattr(self, k) for k in ("slicer", "version", "time_s", "time_silent_s", "filament_mm",
-                                            "filament_cm3", "filament_g", "filament_cost", "layers", "printer",
-                                            "firmware")}
+        out = {k: getattr(self, k) for k in ("slicer", "version", "time_s", "time_silent_s", "time_model_s",
+                                            "filament_mm", "filament_cm3", "filament_g", "filament_cost", "layers",
+                                            "printer", "firmware")}
         out["marks"] = [{"line": m.line, "mode": m.mode, "percent": m.percent, "elapsed_s": m.elapsed_s,
                          "remaining_s": m.remaining_s} for m in self.marks]
         return out
@@ -261,6 +266,7 @@ def slicer_figures(op: "Operation") -> SlicerFigures:
                                                     "TIME", "Print time", "Estimated Build Time",
                                                     "Estimated machine time") if get(k)), None)
     time_silent = parse_duration(get("estimated printing time (silent mode)", "")) or None
+    time_model = parse_duration(get("model printing time", "")) or None
     filament_mm = _total(get("filament used [mm]", ""))
     cm3 = _total(get("filament used [cm3]", ""))
     if cm3 is None and get("Estimated Build Volume"):  # KISSlicer: "0.681 cm^3"
@@ -286,6 +292,7 @@ def slicer_figures(op: "Operation") -> SlicerFigures:
         printer = check[1] if check else None
     figures = SlicerFigures(
         slicer=values.get("slicer"), version=values.get("version"), time_s=time_s, time_silent_s=time_silent,
+        time_model_s=time_model,
         filament_mm=filament_mm, filament_cm3=cm3, filament_g=grams,
         filament_cost=_total(get("total filament cost", "")) or _total(get("filament cost", "")),
         layers=layers, printer=printer, firmware=get("gcode_flavor") or get("FLAVOR") or None,
@@ -302,7 +309,8 @@ def _head_text(op: "Operation") -> str:
 
 
 #: The figures set beside gcodekit's: (label, key in the summary record, key in the slicer's figures).
-COMPARED = (("time", "time_s", "time_s"), ("filament", "filament_mm", "filament_mm"), ("layers", "layers", "layers"))
+COMPARED = (("time", "time_s", "time_s"), ("model time", "time_s", "time_model_s"),
+            ("filament", "filament_mm", "filament_mm"), ("layers", "layers", "layers"))
 
 
 def compare(record: Mapping[str, Any]) -> list[dict[str, Any]]:
