@@ -123,7 +123,7 @@ def last_drawn(a: np.ndarray, b: np.ndarray, width: int, height: int, depth: int
     d /= count[:, None]  # from one sample to the next
     a += d / 2
     ends = np.cumsum(count)
-    pairs = []
+    last = np.zeros(0, np.int64)  # the last `depth` (pixel, segment) keys of each pixel so far
     lo = 0
     while lo < n:
         hi = max(int(np.searchsorted(ends, ends[lo] - count[lo] + CHUNK_SAMPLES, side="right")), lo + 1)
@@ -136,16 +136,26 @@ def last_drawn(a: np.ndarray, b: np.ndarray, width: int, height: int, depth: int
         # one number per (pixel, segment), ordered by pixel, then by drawing order
         key = ((y[inside].astype(np.int64) * width + x[inside].astype(np.int64)) << 32) | seg[inside]
         # a straight segment crosses a pixel once: its samples there follow one another
-        pairs.append(key[np.r_[True, key[1:] != key[:-1]]])
+        key = key[np.r_[True, key[1:] != key[:-1]]] if key.size else key
+        # later chunks are drawn later: what falls out of a pixel's last few now never comes back, so the memory
+        # stays the picture's pixels times `depth` however many samples the segments make (200 k rapids
+        # across the whole picture: 100 M samples)
+        last = _last_per_pixel(np.sort(np.concatenate([last, key])), depth)
         lo = hi
-    key = np.sort(np.concatenate(pairs))
+    keep = np.zeros(n, bool)
+    keep[last & 0xFFFFFFFF] = True
+    return keep
+
+
+def _last_per_pixel(key: np.ndarray, depth: int) -> np.ndarray:
+    """The keys (pixel << 32 | segment, sorted) among the last ``depth`` of their pixel."""
+    if key.size == 0:
+        return key
     cell = key >> 32
     first = np.r_[True, cell[1:] != cell[:-1]]
     last = np.r_[np.flatnonzero(first[1:]), cell.size - 1]  # each pixel's last entry
     from_end = last[np.cumsum(first) - 1] - np.arange(cell.size)
-    keep = np.zeros(n, bool)
-    keep[key[from_end < depth] & 0xFFFFFFFF] = True
-    return keep
+    return key[from_end < depth]
 
 
 def polylines(a: np.ndarray, b: np.ndarray, style: np.ndarray, keep: np.ndarray | None = None) -> Polylines:
