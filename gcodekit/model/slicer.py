@@ -255,8 +255,8 @@ def slicer_figures(op: "Operation") -> SlicerFigures:
                     values["slicer"] = name or _NAMES.get(m[1].lower(), m[1])
                     values["version"] = m[m.lastindex] if m.lastindex else None
                     break
-        elif values["slicer"] == "KISSlicer" and values["version"] is None and _VERSION.match(text):
-            values["version"] = _VERSION.match(text)[1]
+        elif values["slicer"] == "KISSlicer" and values["version"] is None and (m := _VERSION.match(text)):
+            values["version"] = m[1]
         for part in _SEVERAL.split(text):
             m = _SETTING.match(part)
             if m:

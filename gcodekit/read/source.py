@@ -55,6 +55,7 @@ MAX_LINE_LENGTH = 65536
 BINARY_NUL_SHARE = 0.1
 BINARY_NULS = 8
 
+
 def binary_kind(data: bytes) -> str | None:
     """What a file's first bytes hold when they are not program text, or None for text.
 
