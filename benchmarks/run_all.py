@@ -91,8 +91,10 @@ def scale_rows(r: Any) -> list[dict]:
         ratio = x["seconds"] / loop["seconds"] if ours and loop["seconds"] else None
         bpl = x.get("bytes_per_line")
         binds = "plate150" in str(x.get("file", ""))  # the targets are defined on the 3 M-line plate
-        note = (f"{bpl:.0f} B/line" if bpl is not None else "") + ("" if binds or not ours else
-                                                                   "; target binds on plate150")
+        data = x.get("data_bytes_per_line")
+        note = ((f"{bpl:.0f} B/line" if bpl is not None else "")
+                + (f" ({data:.0f} above the {x['runtime_mb']:.0f} MB runtime)" if data is not None and ours else "")
+                + ("" if binds or not ours else "; target binds on plate150"))
         rows.append(row("scale", x.get("file", ""), str(x.get("tool", "")), x.get("seconds"), x.get("peak_mb"), ratio,
                         "<= 0.5x the loop, <= 150 B/line" if ours else "",
                         (ratio <= 0.5 and (bpl is None or bpl <= 150)) if ratio is not None and binds else None,

@@ -65,6 +65,19 @@ def test_scale_rows_compare_each_tool_with_the_loop_on_its_file(run_all):
     assert run_all.scale_rows(rows)[1]["ratio"] == pytest.approx(0.4)  # a plain list too
 
 
+def test_scale_rows_say_how_much_of_the_peak_is_the_runtime(run_all):
+    # made-up figures: a 600 MB peak over 2**20 lines, 150 MB of it held with no program
+    plate = "plate150_marlin2.gcode.gz"
+    rows = [{"tool": "python_loop", "file": plate, "seconds": 10.0, "peak_mb": 20, "bytes_per_line": 20,
+             "lines": 2**20, "runtime_mb": 12, "data_bytes_per_line": 8},
+            {"tool": "gcodekit marlin", "file": plate, "seconds": 4.0, "peak_mb": 600, "bytes_per_line": 600,
+             "lines": 2**20, "runtime_mb": 150, "data_bytes_per_line": 450}]
+    loop, marlin = run_all.scale_rows(rows)
+    assert marlin["note"] == "600 B/line (450 above the 150 MB runtime)"
+    assert marlin["pass"] is False  # the target binds on the whole peak
+    assert loop["note"] == "20 B/line"
+
+
 def test_a_quick_scale_run_shows_its_ratios_without_binding(run_all):
     # bench_scale.py --quick's real record (the cylinder): ratios to the loop, no pass or fail
     loop, *ours = run_all.scale_rows(record("scale"))
