@@ -36,6 +36,21 @@ def test_param_at_reads_dense_sparse_and_missing_columns():
     assert np.isnan(t.param_at("R", rows)).all()
 
 
+def test_commands_read_a_block_as_command_reads_each_row():
+    # sparse and dense words, two comments on one line, a named command, a string argument, a comment line
+    text = ("; start\nG28 ; home (all axes)\nM117 Hello there\nG1 X1 Y2 F100 ; edge ; second\n"
+            "SET_VELOCITY_LIMIT VELOCITY=100\n" + "".join(f"G1 X{i} E{i / 10}\n" for i in range(40))
+            + "M104 S200 T0\nG4 P5\n")
+    t = gcodekit.parse_program(text, flavor="klipper").table
+    t.compact()
+    assert any(isinstance(c, SparseColumn) for c in t.params.values()) and t.named and t.texts
+    n = len(t)
+    for start, stop in [(0, n), (0, 1), (3, 9), (n - 2, n), (2, 2), (-5, 4), (n - 1, n + 10)]:
+        expected = [t.command(i) for i in range(max(start, 0), min(stop, n))]
+        assert t.commands(start, stop) == expected, (start, stop)
+    assert [c.comment for c in t.commands(0, 4)] == ["start", "home (all axes)", None, "edge ; second"]
+
+
 def _moves(rows):
     n = len(rows)
     return PlannerMoves(np.zeros((n, 4)), np.ones((n, 4)), np.ones(n), np.asarray(rows, np.int64), np.arange(n))

@@ -167,3 +167,30 @@ def test_summary_counts_what_each_stage_writes(path):
         moves = sum(1 for line in lines if any(f" G{g} " in f" {line} " for g in (0, 1, 2, 3)))
         expected.append((k, len(lines), moves))
     assert [(s["stage"], s["lines"], s["moves"]) for s in t.summary()] == expected
+
+
+@pytest.mark.parametrize("path", PROGRAMS, ids=lambda p: p.name)
+def test_stages_written_together_match_each_stage_written_alone(path):
+    # summary() writes the seven stages of a row one after another and shares a text between stages that
+    # resolve nothing new for the row (stage 1 in mm, stages 4-6 of a plain move); stage(k) alone shares nothing
+    op = operation(path)
+    together = Transpiler(op)
+    rows = {k: [] for k in STAGES}
+    for row in range(len(op.table)):
+        for k in STAGES:
+            rows[k].extend(together._row(row, k))  # the walk summary() makes
+    for k in STAGES:
+        alone = Transpiler(op).stage(k).splitlines()
+        assert alone[1 + len(together._head(k)):len(alone) - len(together._tail())] == rows[k], k
+
+
+def test_lines_streams_the_stage_text_and_the_summary_counts_it():
+    t = Transpiler(operation(EXAMPLES / "bracket_mill.ngc"))
+    for k in STAGES:
+        lines = list(t.lines(k))
+        assert "\n".join(lines) + "\n" == t.stage(k)
+        assert len(lines) == t.summary()[k]["lines"] + 1  # the title line
+    from gcodekit.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="stage must be one of 0-6"):
+        t.lines(7)  # said at once, not when the lines are first read

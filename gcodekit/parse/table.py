@@ -189,13 +189,37 @@ class CommandTable:
             v = col.at(i) if isinstance(col, SparseColumn) else float(col[i])
             if v == v:
                 params[letter] = v
+        return self._command(i, params, self.comment_of(i))
+
+    def commands(self, start: int, stop: int) -> list[Command]:
+        """``[command(i) for i in range(start, stop)]``, each column read once for the whole block.
+
+        For walking a long table: the rows' words and comments are looked up
+        a block at a time instead of a search per row and column.
+        """
+        start, stop = max(start, 0), min(stop, len(self))
+        if stop <= start:
+            return []
+        columns = [(letter, np.asarray(col.window(start, stop) if isinstance(col, SparseColumn) else col[start:stop],
+                                       float).tolist())
+                   for letter, col in self.params.items()]
+        bounds = np.searchsorted(self.comment_rows, np.arange(start, stop + 1)).tolist()
+        out = []
+        for j in range(stop - start):
+            params = {letter: v for letter, values in columns if (v := values[j]) == v}
+            lo, hi = bounds[j], bounds[j + 1]
+            comment = None if lo == hi else " ".join(self.comment(k) for k in range(lo, hi))
+            out.append(self._command(start + j, params, comment))
+        return out
+
+    def _command(self, i: int, params: dict[str, float], comment: str | None) -> Command:
         cls = COMMAND_CLASSES[Kind(int(self.kind[i]))]
         named = self.named.get(i)
         return cls(
             code=self.code(i),
             params=params,
             line=int(self.line[i]),
-            comment=self.comment_of(i),
+            comment=comment,
             name=NAMES[int(self.name[i])],
             text=named[1] if named else self.texts.get(i, ""),
             profile=self.profiles.get(i),

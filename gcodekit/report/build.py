@@ -17,6 +17,7 @@ Examples
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -76,9 +77,8 @@ def report_data(op: "Operation", *, transpile: bool = True, cut: bool = True) ->
 
         t = Transpiler(op)
         data["stages"] = t.summary()
-        lines = t.stage(6).splitlines()
-        data["toolpath"] = {"text": "\n".join(lines[:MAX_TOOLPATH_LINES]), "lines": len(lines),
-                            "shown": min(len(lines), MAX_TOOLPATH_LINES)}
+        shown = list(itertools.islice(t.lines(6), MAX_TOOLPATH_LINES))  # the title line, then the summary's lines
+        data["toolpath"] = {"text": "\n".join(shown), "lines": data["stages"][6]["lines"] + 1, "shown": len(shown)}
     if cut and summary["process"] == "subtractive" and "lathe" not in op.machine.name:
         from .cut import cut_section
 

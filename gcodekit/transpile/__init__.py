@@ -40,7 +40,9 @@ N3 M2
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import re
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Iterator
 
 import numpy as np
 
@@ -72,6 +74,37 @@ _POLAR = {"polar_on", "polar_off"}
 #: What the last stage keeps besides motion: dwell, tools, spindle, coolant, stops and the end.
 _KEPT = {"dwell", "tool_change", "spindle_cw", "spindle_ccw", "spindle_off", "coolant_mist", "coolant_flood",
          "coolant_off", "program_stop", "optional_stop", "program_end"}
+#: Commands read from the table at a time while the stages are written
+_BLOCK_ROWS = 4096
+#: A motion line: G0-G3 as a word of its own (between spaces or the line's ends)
+_MOVE_WORD = re.compile(r"(?<![^ ])G[0-3](?![^ ])")
+
+
+@dataclass
+class _Row:
+    """What one command row's stages share: read once, while the stages of the row are written.
+
+    ``texts`` keeps the expensive parts already written for this row, keyed
+    by everything they depend on, so two stages that resolve nothing new
+    for the row (stage 1 of a program in mm, stages 4-6 of a plain move)
+    share one text.
+    """
+
+    row: int
+    cmd: Any
+    name: str
+    kind: Kind
+    points: range  # the row's waypoints
+    motion_row: bool
+    polar: bool  # polar words, or G16 in force
+    g16: bool  # G16 in force: X is a radius, Y an angle
+    rotated: bool  # moves under a G10 L2 R rotation
+    diameter: bool  # G7 in force
+    incremental: bool  # G91 in force
+    arc_absolute: bool  # G90.1 in force
+    texts: dict = field(default_factory=dict)
+    offset: np.ndarray | None = None  # mm, from program to machine coordinates (see Transpiler._offset)
+    scale: float | None = None  # output length units per program unit (see Transpiler._scale)
 
 
 class Transpiler:
@@ -118,20 +151,35 @@ class Transpiler:
         # each command row's waypoints, w["command"] being sorted: rows[r]..rows[r + 1] - 1, looked up once
         self._first_waypoint = np.searchsorted(w["command"], np.arange(len(self.op.table) + 1)) \
             if "command" in w else None
-        self._command_of = (-1, None)  # the last row's Command: the stages of one row share it
+        # the rows with a waypoint that moves (w["command"] sorted, so a row's waypoints are its stretch)
+        self._motion_rows = None
+        if self._first_waypoint is not None:
+            self._motion_rows = np.zeros(len(self.op.table), bool)
+            moving = np.asarray(w["command"])[np.asarray(w["motion"]) > 0]
+            self._motion_rows[moving[(moving >= 0) & (moving < len(self.op.table))]] = True
+        self._current: _Row | None = None  # the row being written: its stages share it
+        self._block_start, self._block = 0, []  # the commands of the rows being written, read a block at a time
 
     # -- public -----------------------------------------------------------------
 
     def stage(self, k: int) -> str:
         """G-code text of stage ``k`` (0-6)."""
+        return "\n".join(self.lines(k)) + "\n"
+
+    def lines(self, k: int) -> Iterator[str]:
+        """The lines of stage ``k`` (0-6) one at a time, title first, without holding the whole text."""
         if k not in STAGES:
             from ..errors import ConfigError
 
             raise ConfigError(f"stage must be one of 0-6, not {k!r}")
-        lines = [self._title(k)] + self._head(k)
+        return self._lines(k)
+
+    def _lines(self, k: int) -> Iterator[str]:
+        yield self._title(k)
+        yield from self._head(k)
         for row in range(len(self.op.table)):
-            lines.extend(self._row(row, k))
-        return "\n".join(lines + self._tail()) + "\n"
+            yield from self._row(row, k)
+        yield from self._tail()
 
     def _title(self, k: int) -> str:
         frame = "absolute machine coordinates" if k >= 4 else "machine coordinates" if k >= 2 else "program coordinates"
@@ -162,62 +210,82 @@ class Transpiler:
         Counted in one pass over the commands for every stage, without
         keeping any stage's text.
         """
-        def is_move(line: str) -> bool:
-            return any(f" G{g} " in f" {line} " for g in (0, 1, 2, 3))
-
         lines = {k: self._head(k) + self._tail() for k in STAGES}
-        counts = {k: [len(lines[k]), sum(map(is_move, lines[k]))] for k in STAGES}
+        counts = {k: [len(lines[k]), sum(1 for line in lines[k] if _MOVE_WORD.search(line))] for k in STAGES}
         for row in range(len(self.op.table)):
             for k in STAGES:
                 out = self._row(row, k)
                 counts[k][0] += len(out)
-                counts[k][1] += sum(map(is_move, out))
+                counts[k][1] += sum(1 for line in out if _MOVE_WORD.search(line))
         return [{"stage": k, "name": STAGE_NAMES[k], "lines": counts[k][0], "moves": counts[k][1]} for k in STAGES]
 
     # -- one command --------------------------------------------------------------
 
     def _row(self, row: int, k: int) -> list[str]:
-        t = self.op.table
-        name = NAMES[int(t.name[row])]
-        kind = Kind(int(t.kind[row]))
-        cmd = self._command(row)
+        r = self._facts(row)
+        name, kind, cmd = r.name, r.kind, r.cmd
         n = f"N{cmd.line}"
-        comment = self._comment(row, cmd, k)
+        comment = self._comment(r, k)
         if kind == Kind.COMMENT:
             return [f"({_paren(cmd.comment or '')})"] if cmd.comment else []
-        moving = self._waypoints(row)
-        motion_row = moving.size and np.any(self.op.waypoints["motion"][moving] > 0)
-        polar = "@" in cmd.params or "^" in cmd.params or self._polar_rows[row]
-        polar_stage = 2 if self._polar_rows[row] else 3
-        if motion_row and (k >= 4 or (polar and k >= polar_stage) or (self._rotated_rows[row] and k >= 2)):
-            return self._from_waypoints(row, k, moving, comment)
+        polar_stage = 2 if r.g16 else 3
+        if r.motion_row and (k >= 4 or (r.polar and k >= polar_stage) or (r.rotated and k >= 2)):
+            return self._from_waypoints(r, k, comment)
         if (k >= 1 and name in _UNITS) or (k >= 2 and name in _OFFSETS) or (k >= 4 and name in _DISTANCE) \
                 or (k >= 2 and name in _POLAR) or (k >= 4 and name in _COMP) or (k >= 6 and name in _CYCLE_MODES):
             return [f"({n} {_paren(str(cmd))} resolved)"] if k < 6 else []
-        if k >= 6 and not motion_row and name not in _KEPT and kind not in (Kind.FEED_RATE, Kind.MILL):
+        if k >= 6 and not r.motion_row and name not in _KEPT and kind not in (Kind.FEED_RATE, Kind.MILL):
             return [f"(dropped: {n} {_paren(str(cmd))})"]
-        words = self._words(row, cmd, k)
+        words = self._words(r, k)
         return [f"{n} {words}{comment}".rstrip()]
 
-    def _command(self, row: int):
-        if self._command_of[0] != row:
-            self._command_of = (row, self.op.table.command(row))
-        return self._command_of[1]
+    def _facts(self, row: int) -> _Row:
+        """The row's :class:`_Row`, read on its first stage."""
+        if self._current is None or self._current.row != row:
+            t = self.op.table
+            if not self._block_start <= row < self._block_start + len(self._block):
+                self._block_start, self._block = row, t.commands(row, row + _BLOCK_ROWS)
+            cmd = self._block[row - self._block_start]
+            if self._first_waypoint is None:
+                points = range(row, row + 1)
+            else:
+                points = range(int(self._first_waypoint[row]), int(self._first_waypoint[row + 1]))
+            if self._motion_rows is None:
+                motion_row = bool(np.any(self.op.waypoints["motion"][points.start:points.stop] > 0))
+            else:
+                motion_row = bool(self._motion_rows[row])
+            g16 = bool(self._polar_rows[row])
+            self._current = _Row(row, cmd, NAMES[int(t.name[row])], Kind(int(t.kind[row])), points, motion_row,
+                                 polar="@" in cmd.params or "^" in cmd.params or g16, g16=g16,
+                                 rotated=bool(self._rotated_rows[row]), diameter=bool(self._diameter_rows[row]),
+                                 incremental=bool(self._incremental_rows[row]),
+                                 arc_absolute=bool(self._arc_absolute_rows[row]))
+        return self._current
 
-    def _waypoints(self, row: int) -> np.ndarray:
-        if self._first_waypoint is None:
-            return np.array([row])
-        return np.arange(self._first_waypoint[row], self._first_waypoint[row + 1])
+    def _words(self, r: _Row, k: int) -> str:
+        """The command's own words, with units (stage 1+) and offsets (2+) resolved.
 
-    def _words(self, row: int, cmd, k: int) -> str:
-        """The command's own words, with units (stage 1+) and offsets (2+) resolved."""
-        name = NAMES[int(self.op.table.name[row])]
-        scale = self._scale(row) if k >= 1 else 1.0
-        offset = self._offset(row) / self.unit if k >= 2 else np.zeros(3)
-        absolute = not self._incremental(row)
+        Written once for each set of what they depend on (the scale, the
+        halving of diameters, the offset added, the polar words dropped).
+        """
+        scale = self._scale(r) if k >= 1 else 1.0
+        halve = k >= 1 and r.diameter
+        offset = self._offset(r) if k >= 2 and not r.incremental else None
+        # an offset of zero adds nothing (-0.0 + 0.0 is 0.0, and both are written "0"): such a stage shares the text
+        key = ("words", scale, halve, None if offset is None or not offset.any() else tuple(offset),
+               k >= 3 and ("@" in r.cmd.params or "^" in r.cmd.params))
+        if key not in r.texts:
+            r.texts[key] = self._written_words(r, scale, halve, None if offset is None else offset / self.unit,
+                                               skip_polar=key[-1])
+        return r.texts[key]
+
+    def _written_words(self, r: _Row, scale: float, halve: bool, offset: np.ndarray | None,
+                       skip_polar: bool) -> str:
+        """:meth:`_words` for one scale, halving, offset (None: added nowhere) and polar choice."""
+        name, cmd = r.name, r.cmd
         lengths = length_words(name)
         halved = diameter_words(name)
-        plane = int(self.op.waypoints["plane"][self._waypoints(row)[-1]])
+        plane = int(self.op.waypoints["plane"][r.points[-1]])
         normal = "XYZ"[PLANES[plane][0][2]]
         levels = level_words(name, plane) if name in CYCLE_NAMES and name not in LATHE_CYCLE_NAMES else ""
         words = [cmd.code] if cmd.code and not cmd.code.startswith(("#", "@")) else []
@@ -225,48 +293,61 @@ class Transpiler:
         if name in LATHE_CYCLE_NAMES and scale != 1.0:
             params = {**params, **lathe_defaults(name, params)}
         for letter, value in params.items():
-            if letter in "@^" and k >= 3:
+            if letter in "@^" and skip_polar:
                 continue
-            angle = letter == "Y" and self._polar_rows[row]  # G16: Y is an angle in degrees
+            angle = letter == "Y" and r.g16  # G16: Y is an angle in degrees
             v = value * scale if (letter in lengths or letter == "F") and not angle else value
-            if letter in halved and k >= 1 and self._diameter_rows[row]:
+            if letter in halved and halve:
                 v /= 2.0
-            if absolute and k >= 2 and (letter in "XYZ" or letter in levels):
+            if offset is not None and (letter in "XYZ" or letter in levels):
                 v += offset["XYZ".index(normal if letter in levels else letter)]
             words.append(f"{letter}{format_number(v, self.precision)}")
         return " ".join(words + ([cmd.text] if cmd.text else []))
 
-    def _scale(self, row: int) -> float:
-        """Output length units per program unit at ``row``."""
-        return (MM_PER_INCH if self.op.waypoints["units"][self._waypoints(row)[-1]] == 1 else 1.0) / self.unit
+    def _scale(self, r: _Row) -> float:
+        """Output length units per program unit at the row."""
+        if r.scale is None:
+            r.scale = (MM_PER_INCH if self.op.waypoints["units"][r.points[-1]] == 1 else 1.0) / self.unit
+        return r.scale
 
-    def _comment(self, row: int, cmd, k: int) -> str:
+    def _comment(self, r: _Row, k: int) -> str:
         """The command's comment as written out; a lathe cycle's profile takes the stage's units and offsets."""
+        cmd = r.cmd
         text = cmd.comment
         if cmd.profile is not None and k < 6:  # the cycle line is still there: so must its profile be
             body = None
             if k >= 1:
-                offset = self._offset(row) / self.unit if k >= 2 else np.zeros(3)
-                body = rewrite_profile(cmd.profile, scale=self._scale(row), halve=bool(self._diameter_rows[row]),
+                offset = self._offset(r) / self.unit if k >= 2 else np.zeros(3)
+                body = rewrite_profile(cmd.profile, scale=self._scale(r), halve=r.diameter,
                                        offset_x=offset[0], offset_z=offset[2],
-                                       arc_absolute=bool(self._arc_absolute_rows[row]), precision=self.precision)
+                                       arc_absolute=r.arc_absolute, precision=self.precision)
             text = written_comment(text, cmd.profile, body)
         return f" ({_paren(text)})" if text else ""
 
-    def _from_waypoints(self, row: int, k: int, points: np.ndarray, comment: str) -> list[str]:
+    def _from_waypoints(self, r: _Row, k: int, comment: str) -> list[str]:
         """Machine-frame moves of a command (stages 4-6; 2-3 for polar moves).
 
         Before stage 4 G91 may still be in force: the moves are then written
-        as increments from the point before.
+        as increments from the point before.  Written once for each set of
+        what they depend on (stages 4-6 of a plain move are one text).
         """
-        t, w = self.op.table, self.op.waypoints
-        n = f"N{int(t.line[row])}"
-        cycle = int(t.motion[row]) == MOTION_CYCLE or NAMES[int(t.name[row])] in CYCLE_NAMES
-        if cycle and k < 6 and not self._rotated_rows[row]:
-            return [f"{n} {self._words(row, self._command(row), k)}{comment}"]
+        row = r.row
+        cycle = int(self.op.table.motion[row]) == MOTION_CYCLE or r.name in CYCLE_NAMES
+        if cycle and k < 6 and not r.rotated:
+            return [f"N{r.cmd.line} {self._words(r, k)}{comment}"]
+        increments = k < 4 and r.incremental
+        absolute_centre = k < 4 and r.arc_absolute  # G90.1 still in force
+        key = ("moves", increments, absolute_centre, cycle and k >= 6, comment)
+        if key not in r.texts:
+            r.texts[key] = self._written_moves(r, increments, absolute_centre, cycle and k >= 6, comment)
+        return list(r.texts[key])
+
+    def _written_moves(self, r: _Row, increments: bool, absolute_centre: bool, dwells: bool,
+                       comment: str) -> list[str]:
+        """:meth:`_from_waypoints` for one choice of increments, arc centres and cycle dwells."""
+        w = self.op.waypoints
+        n = f"N{r.cmd.line}"
         fmt = lambda v: format_number(v, self.precision)  # noqa: E731
-        increments = k < 4 and self._incremental(row)
-        absolute_centre = k < 4 and bool(self._arc_absolute_rows[row])  # G90.1 still in force
 
         def value(axis: str, p: int) -> float:
             column = w[axis.lower()]
@@ -274,7 +355,7 @@ class Transpiler:
             return v / self.unit if axis in "XYZ" else v
 
         lines = []
-        for p in points:
+        for p in r.points:
             motion = int(w["motion"][p])
             if motion == 0:
                 continue
@@ -291,9 +372,9 @@ class Transpiler:
                 lines.append(f"{n} {self._arc(p, motion, absolute_centre)} {coords}{feed}")
         if lines:
             lines[-1] += comment
-        dwell = self._command(row).params.get("P") if cycle and NAMES[int(t.name[row])] in (
+        dwell = r.cmd.params.get("P") if dwells and r.name in (
             "cycle_drill_dwell", "cycle_bore_stop", "cycle_bore_dwell") else None
-        if dwell is not None and k >= 6 and len(lines) >= 2:
+        if dwell is not None and len(lines) >= 2:
             lines.insert(len(lines) - 1, f"{n} G4 P{fmt(dwell)}")
         return lines
 
@@ -316,33 +397,35 @@ class Transpiler:
         code = "G2" if motion == 3 else "G3"
         return (f"G{plane} " if self._plane_words else "") + f"{code} {words}"
 
-    def _offset(self, row: int) -> np.ndarray:
-        """Offset (mm, X Y Z) from program to machine coordinates in force at ``row``.
+    def _offset(self, r: _Row) -> np.ndarray:
+        """Offset (mm, X Y Z) from program to machine coordinates in force at the row.
 
         Read off the row's waypoints: a move with an absolute word v ends at
         v*scale + offset (a cycle's words, see :func:`.cycle_words.cycle_offset`).
+        Worked out once per row.
         """
-        w = self.op.waypoints
-        points = self._waypoints(row)
-        cmd = self._command(row)
-        if self._incremental(row):
+        if r.offset is None:
+            r.offset = self._read_offset(r)
+        return r.offset
+
+    def _read_offset(self, r: _Row) -> np.ndarray:
+        w, row, points = self.op.waypoints, r.row, r.points
+        if r.incremental:
             return np.zeros(3)
-        scale = MM_PER_INCH if w["units"][points[-1]] == 1 else 1.0
-        words = dict(cmd.params)
-        if "X" in words and self._diameter_rows[row]:
+        last = points[-1]
+        scale = MM_PER_INCH if w["units"][last] == 1 else 1.0
+        words = dict(r.cmd.params)
+        if "X" in words and r.diameter:
             words["X"] /= 2.0  # G7: the X word is a diameter
-        positions = np.column_stack([np.asarray(w[a])[points] for a in "xyz"])
-        name = NAMES[int(self.op.table.name[row])]
+        name = r.name
         if name in CYCLE_NAMES or int(self.op.table.motion[row]) == MOTION_CYCLE:
             if name not in CYCLE_NAMES:  # axis words alone, repeating the cycle in force
                 name = NAMES[int(self.op.table.name[self._last_cycle_row[row]])]
-            feeds = np.asarray(w["motion"])[points] == MOTION_LINEAR
-            return cycle_offset(name, words, scale, positions, feeds, int(w["plane"][points[-1]]))
-        return np.array([positions[-1, i] - words[a] * scale if a in words else 0.0 for i, a in enumerate("XYZ")])
-
-    def _incremental(self, row: int) -> bool:
-        """G91 in force at ``row`` (from the distance-mode commands up to it)."""
-        return bool(self._incremental_rows[row])
+            span = slice(points.start, points.stop)
+            positions = np.column_stack([np.asarray(w[a])[span] for a in "xyz"])
+            feeds = np.asarray(w["motion"])[span] == MOTION_LINEAR
+            return cycle_offset(name, words, scale, positions, feeds, int(w["plane"][last]))
+        return np.array([w[a][last] - words[a.upper()] * scale if a.upper() in words else 0.0 for a in "xyz"])
 
 
 def _paren(text: str) -> str:
