@@ -55,6 +55,12 @@ class GrowingColumn:
             self._room_view(count)[:] = value
             self.size += count
 
+    def values(self) -> np.ndarray:
+        """A writable view of the values so far (valid until the next append)."""
+        if self._map is None:
+            return np.empty(0, self.dtype)
+        return np.frombuffer(self._map, self.dtype, count=self.size)
+
     def finish(self) -> np.ndarray:
         """The values as one array, backed by the column's memory (the column is empty afterwards)."""
         mapping, size = self._map, self.size

@@ -8,6 +8,7 @@ chunk is a zero-stride view of one value (equal, or NaN).
 from __future__ import annotations
 
 import mmap
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -19,7 +20,7 @@ from gcodekit.errors import Diagnostics
 from gcodekit.growing import GrowingColumn
 from gcodekit.parse import GcodeParser
 from gcodekit.parse.join import TableJoiner
-from gcodekit.parse.table import CommandTable, SparseColumn
+from gcodekit.parse.table import CommandTable, DecimalColumn, SparseColumn
 from gcodekit.pipeline.assemble import WaypointJoiner
 from gcodekit.read import read_text
 from gcodekit.syntax import load_flavor
@@ -118,9 +119,10 @@ def test_no_chunk_or_one_chunk(n):
 
 
 def _tables_joined_at_the_end(parts: list[CommandTable]) -> CommandTable:
-    """The reference: every chunk's table kept, then each column joined (the pipeline's way before TableJoiner)."""
+    """The reference: every chunk's table kept, then each column joined (the pipeline's way before TableJoiner),
+    its dense words then stored as decimals where they can be."""
     if len(parts) == 1:
-        return parts[0].compact()
+        return parts[0].compact().store_decimals()
     sizes = [len(p) for p in parts]
     shift = np.cumsum([0] + sizes[:-1])
     n = sum(sizes)
@@ -147,11 +149,19 @@ def _tables_joined_at_the_end(parts: list[CommandTable]) -> CommandTable:
         texts={k + int(s): v for p, s in zip(parts, shift) for k, v in p.texts.items()},
         deleted=np.concatenate([p.deleted + s for p, s in zip(parts, shift)]),
         profiles={k + int(s): v for p, s in zip(parts, shift) for k, v in p.profiles.items()},
-    ).compact()
+    ).compact().store_decimals()
 
 
+# decimal words: X takes one place or none (its units scaled as chunks come), X300000000 passes int32 units at
+# one place (the letter then floats), Y-0 cannot be a unit (-0.0), E0.125 needs three places
 LINES = ["G1 X1.5 Y2 E0.1 F1200", "G1 X3 Y-0", "G0 Z0.3", "M104 S200", "; a comment", "M117 hello there",
-         "/G1 X9 Y9", "T1", "G1 E-0.8 F2400", "G92 E0", "M106 S255 P1", "", "G4 P100 ; dwell"]
+         "/G1 X9 Y9", "T1", "G1 E-0.8 F2400", "G92 E0", "M106 S255 P1", "", "G4 P100 ; dwell",
+         "G1 X300000000 E0.125", "G1 Y7.25 E2"]
+
+
+class DecimalFields(NamedTuple):
+    places: int
+    units: np.ndarray
 
 
 def _chunk_tables(chunks: list[list[int]], sparse: list[bool]) -> list[CommandTable]:
@@ -167,7 +177,10 @@ def _table_fields(t: CommandTable) -> dict:
     out = {name: np.asarray(getattr(t, name)) for name in
            ("line", "kind", "letter", "number", "name", "motion", "comment_rows", "comment_offsets", "deleted")}
     for letter, c in t.params.items():
-        out[letter] = (c.rows, c.values, c.size) if isinstance(c, SparseColumn) else c
+        if isinstance(c, DecimalColumn):
+            out[letter] = DecimalFields(c.places, c.units)
+        else:
+            out[letter] = (c.rows, c.values, c.size) if isinstance(c, SparseColumn) else c
     out.update(letters=list(t.params), data=t.comment_data, named=t.named, texts=t.texts, profiles=t.profiles)
     return out
 
@@ -186,6 +199,9 @@ def test_tables_joined_as_they_come_are_the_ones_joined_at_the_end(chunks, spars
         if isinstance(value, np.ndarray):
             assert got[key].dtype == value.dtype, key
             np.testing.assert_array_equal(got[key].view(np.uint8), value.view(np.uint8), err_msg=key)
+        elif isinstance(value, DecimalFields):  # decimal units: the joiner's places grow as the chunks need
+            assert isinstance(got[key], DecimalFields) and got[key].places == value.places, key
+            assert np.array_equal(got[key].units, value.units), key
         elif isinstance(value, tuple):  # a sparse column
             assert isinstance(got[key], tuple) and got[key][2] == value[2], key
             for a, b in zip(got[key][:2], value[:2]):

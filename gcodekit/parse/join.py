@@ -4,8 +4,12 @@
 program's columns are held once, in :class:`~gcodekit.growing.GrowingColumn`
 maps, rather than per chunk and then joined.  A parameter letter stays
 sparse while every chunk has it sparse (or not at all) and turns dense from
-the first chunk that has it dense; the joined table is compacted as any
-table is (see :meth:`.CommandTable.compact`).
+the first chunk that has it dense.  Dense words are kept as decimal units
+(:class:`~.table.DecimalColumn`, half the memory) while every word so far
+comes back from them bit for bit: a chunk with more decimals scales the
+units kept so far, and a word no int32 unit can hold (a computed value, a
+-0.0) turns the letter to floats for good.  The joined table is compacted
+as any table is (see :meth:`.CommandTable.compact`).
 """
 
 from __future__ import annotations
@@ -13,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..growing import GrowingColumn
-from .table import CommandTable, SparseColumn
+from .table import CommandTable, DecimalColumn, SparseColumn, decimal_units, fewest_places
 
 __all__ = ["TableJoiner"]
 
@@ -21,18 +25,20 @@ _COLUMNS = ("line", "kind", "letter", "number", "name", "motion")
 
 
 class _Param:
-    """One parameter letter across the chunks: sparse pieces until a chunk has it dense."""
+    """One parameter letter across the chunks: sparse pieces until a chunk has it dense, then decimal
+    units (``places`` decimals) while they hold every word, floats after."""
 
     def __init__(self) -> None:
         self.pieces: list[tuple[int, int, SparseColumn | None]] = []  # (first row, rows, column) while sparse
         self.dense: GrowingColumn | None = None
+        self.places: int | None = None  # the dense column's decimal places; None once it holds floats
 
     def add(self, col: np.ndarray | SparseColumn | None, first_row: int, rows: int) -> None:
         if self.dense is None and not isinstance(col, np.ndarray):
             self.pieces.append((first_row, rows, col))
             return
         if self.dense is None:  # the first dense chunk: the earlier ones written out densely
-            self.dense = GrowingColumn(np.float64)
+            self.dense, self.places = GrowingColumn(np.int32), 0
             for _, size, piece in self.pieces:
                 self._add_dense(piece, size)
             self.pieces = []
@@ -41,13 +47,43 @@ class _Param:
     def _add_dense(self, col: np.ndarray | SparseColumn | None, rows: int) -> None:
         assert self.dense is not None
         if col is None:
-            self.dense.fill(np.nan, rows)
-        else:
-            self.dense.append(col.dense() if isinstance(col, SparseColumn) else col)
+            self.dense.fill(np.nan if self.places is None else DecimalColumn.NO_WORD, rows)
+            return
+        values = col.dense() if isinstance(col, SparseColumn) else col
+        if self.places is not None:
+            units = decimal_units(values, self.places)
+            if units is None:
+                places = fewest_places(values, self.places + 1)
+                units = None if places is None or not self._scale_units(places) else decimal_units(values, places)
+            if units is not None:
+                self.dense.append(units)
+                return
+            self._to_floats()
+        self.dense.append(values)
 
-    def finish(self, n: int) -> np.ndarray | SparseColumn:
+    def _scale_units(self, places: int) -> bool:
+        """The units kept so far rescaled to ``places`` decimals (the same values), or False where one
+        would pass int32."""
+        assert self.dense is not None and self.places is not None
+        units, factor = self.dense.values(), 10 ** (places - self.places)
+        given = units != DecimalColumn.NO_WORD
+        if given.any() and np.abs(units[given].astype(np.int64)).max() * factor >= 2 ** 31 - 1:
+            return False
+        units[given] *= factor
+        self.places = places
+        return True
+
+    def _to_floats(self) -> None:
+        """From decimal units to floats, for a word they cannot give back."""
+        assert self.dense is not None and self.places is not None
+        kept = DecimalColumn(self.dense.finish(), self.places)
+        self.dense, self.places = GrowingColumn(np.float64), None
+        self.dense.append(kept.dense())
+
+    def finish(self, n: int) -> np.ndarray | SparseColumn | DecimalColumn:
         if self.dense is not None:
-            return self.dense.finish()
+            values = self.dense.finish()
+            return values if self.places is None else DecimalColumn(values, self.places)
         given = [(first, c) for first, _, c in self.pieces if c is not None]
         return SparseColumn(np.concatenate([c.rows + np.int64(first) for first, c in given]),
                             np.concatenate([c.values for _, c in given]), n)
@@ -108,7 +144,7 @@ class TableJoiner:
     def finish(self) -> CommandTable | None:
         """The program's table (None when no chunk came); the joiner is spent."""
         if not self._joined:
-            return None if self._first is None else self._first.compact()
+            return None if self._first is None else self._first.compact().store_decimals()
         n = self._n
         table = CommandTable(
             **{name: column.finish() for name, column in self._columns.items()},  # type: ignore[union-attr]

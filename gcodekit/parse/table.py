@@ -2,7 +2,9 @@
 
 Rows are in execution order.  Parameters are float columns keyed by word
 letter (NaN where a command has no such word); letters used by few rows are
-kept sparse.  :meth:`CommandTable.command` builds the typed object of a row.
+kept sparse, and the words of a program's table written with a few
+decimals as int32 units (:class:`DecimalColumn`).  :meth:`CommandTable.command`
+builds the typed object of a row.
 """
 
 from __future__ import annotations
@@ -87,6 +89,99 @@ class SparseColumn:
 
 
 @dataclass
+class DecimalColumn:
+    """A dense column of words written with at most ``places`` decimals, stored as int32 units.
+
+    ``X12.345`` is 12345 units at 3 places.  The value read back is
+    ``units / 10**places``, one correctly rounded division, which is the
+    double nearest the written decimal: the parser's own value, to the last
+    bit (:meth:`encode` checks every value).  Half the size of a float64
+    column; NaN (no word) is stored as :data:`NO_WORD`.
+    """
+
+    units: np.ndarray
+    places: int
+
+    #: The units of a row with no word
+    NO_WORD = np.iinfo(np.int32).min
+
+    @property
+    def size(self) -> int:
+        return int(self.units.size)
+
+    def __len__(self) -> int:
+        return self.size
+
+    def __getitem__(self, index) -> np.ndarray | float:
+        """The values of the rows ``index`` (an int, a slice or indices), as float64."""
+        units = self.units[index]
+        if np.ndim(units) == 0:
+            return float("nan") if units == self.NO_WORD else float(units / 10.0 ** self.places)
+        return self._values(units)
+
+    def _values(self, units: np.ndarray) -> np.ndarray:
+        out = np.divide(units, 10.0 ** self.places)
+        out[units == self.NO_WORD] = np.nan
+        return out
+
+    def dense(self) -> np.ndarray:
+        return self._values(self.units)
+
+    def window(self, start: int, stop: int) -> np.ndarray:
+        return self._values(self.units[start:stop])
+
+    def at(self, i: int) -> float:
+        return self[i]
+
+    @classmethod
+    def encode(cls, values: np.ndarray, max_places: int = 6, block: int = 1 << 18) -> "DecimalColumn | None":
+        """``values`` as units at the fewest places that give every value back bit for bit, or None.
+
+        None when some value needs more than ``max_places`` decimals or more
+        than int32 units, or is -0.0 or infinite (program arithmetic gives
+        such values; written words rarely do).  Checked ``block`` values at
+        a time, so the check holds no second copy of a long column.
+        """
+        values = np.asarray(values)
+        if values.dtype != np.float64 or values.ndim != 1:
+            return None
+        places = fewest_places(values[:4096], 0, max_places)
+        while places is not None and places <= max_places:
+            units = np.empty(values.size, np.int32)
+            for lo in range(0, values.size, block):
+                part = decimal_units(values[lo:lo + block], places)
+                if part is None:
+                    break
+                units[lo:lo + block] = part
+            else:
+                return cls(units, places)
+            places += 1
+        return None
+
+
+def fewest_places(values: np.ndarray, start: int = 0, max_places: int = 6) -> int | None:
+    """The fewest decimal places, from ``start``, at which :func:`decimal_units` takes ``values``, or None."""
+    return next((k for k in range(start, max_places + 1) if decimal_units(values, k) is not None), None)
+
+
+def decimal_units(values: np.ndarray, places: int) -> np.ndarray | None:
+    """``values`` as int32 units at ``places`` decimals (NaN as ``NO_WORD``), or None unless each comes
+    back bit for bit (see :class:`DecimalColumn`)."""
+    if values.dtype != np.float64:
+        return None
+    given = ~np.isnan(values)
+    scaled = values * 10.0 ** places
+    if not (np.abs(scaled[given]) < 2.0 ** 31 - 1).all():
+        return None
+    units = np.where(given, np.rint(scaled), DecimalColumn.NO_WORD).astype(np.int32)
+    back = np.divide(units, 10.0 ** places)
+    back[~given] = np.nan
+    if not np.array_equal(back.view(np.int64), values.view(np.int64)):  # -0.0 and NaN payloads too
+        return None
+    return units
+
+
+@dataclass
 class CommandTable:
     """Columns of parsed commands.
 
@@ -105,7 +200,7 @@ class CommandTable:
         Index into :data:`NAMES`.
     motion : ndarray of uint8
         Motion mode in force for the command (see :data:`MOTION_NAMES`).
-    params : dict of str to ndarray or SparseColumn
+    params : dict of str to ndarray, SparseColumn or DecimalColumn
     comment_rows : ndarray of int32
         Row of each comment (sorted); a row may have several.
     comment_offsets : ndarray of int64
@@ -129,7 +224,7 @@ class CommandTable:
     number: np.ndarray
     name: np.ndarray
     motion: np.ndarray
-    params: dict[str, np.ndarray | SparseColumn]
+    params: dict[str, np.ndarray | SparseColumn | DecimalColumn]
     comment_rows: np.ndarray
     comment_offsets: np.ndarray
     comment_data: bytes
@@ -146,7 +241,7 @@ class CommandTable:
         col = self.params.get(letter)
         if col is None:
             return np.full(len(self), np.nan)
-        return col.dense() if isinstance(col, SparseColumn) else col
+        return col.dense() if isinstance(col, (SparseColumn, DecimalColumn)) else col
 
     def param_at(self, letter: str, rows: np.ndarray) -> np.ndarray:
         """The word ``letter`` of the commands ``rows`` (NaN where not given), without a dense column."""
@@ -186,7 +281,7 @@ class CommandTable:
         i %= n
         params = {}
         for letter, col in self.params.items():
-            v = col.at(i) if isinstance(col, SparseColumn) else float(col[i])
+            v = col.at(i) if isinstance(col, (SparseColumn, DecimalColumn)) else float(col[i])
             if v == v:
                 params[letter] = v
         return self._command(i, params, self.comment_of(i))
@@ -200,8 +295,8 @@ class CommandTable:
         start, stop = max(start, 0), min(stop, len(self))
         if stop <= start:
             return []
-        columns = [(letter, np.asarray(col.window(start, stop) if isinstance(col, SparseColumn) else col[start:stop],
-                                       float).tolist())
+        columns = [(letter, np.asarray(col.window(start, stop) if isinstance(col, (SparseColumn, DecimalColumn))
+                                       else col[start:stop], float).tolist())
                    for letter, col in self.params.items()]
         bounds = np.searchsorted(self.comment_rows, np.arange(start, stop + 1)).tolist()
         out = []
@@ -231,8 +326,18 @@ class CommandTable:
         for letter, col in list(self.params.items()):
             if isinstance(col, SparseColumn):
                 continue
-            given = ~np.isnan(col)
+            given = col.units != DecimalColumn.NO_WORD if isinstance(col, DecimalColumn) else ~np.isnan(col)
             if np.count_nonzero(given) < _SPARSE_BELOW * n:  # counted first: a dense column's rows are not listed
                 rows = np.flatnonzero(given)
                 self.params[letter] = SparseColumn(rows.astype(np.int64), col[rows], n)
+        return self
+
+    def store_decimals(self) -> "CommandTable":
+        """Store each dense parameter whose words all have a few decimals as a :class:`DecimalColumn`
+        (half the memory; the same values to the last bit)."""
+        for letter, col in list(self.params.items()):
+            if isinstance(col, np.ndarray):
+                encoded = DecimalColumn.encode(col)
+                if encoded is not None:
+                    self.params[letter] = encoded
         return self
