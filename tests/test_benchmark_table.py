@@ -145,3 +145,12 @@ def test_a_failed_target_shows_and_sets_the_exit_status(run_all, tmp_path, monke
     monkeypatch.setattr(run_all, "run", lambda bench, quick, folder: failing if bench.name == "report" else [])
     assert run_all.main(["--only", "report", "--out", str(tmp_path)]) == 1
     assert "| FAIL |" in (tmp_path / "benchmarks.md").read_text()
+
+
+def test_the_mill_report_row_is_informative(run_all):
+    # made-up figures: bench_report.py --mill's record beside the cylinder's
+    rows = run_all.report_rows({"single": {"file": "cylinder_marlin2.gcode", "seconds": 2.0, "target_s": 10.0},
+                                "mill": {"file": "surface_200k.ngc", "moves": 200_000, "seconds": 14.5}})
+    assert [r["pass"] for r in rows] == [True, None]
+    assert rows[1]["file"] == "mill surfacing, 200,000 moves" and rows[1]["seconds"] == 14.5
+    assert rows[1]["target"] == "" and rows[1]["ratio"] is None
