@@ -168,7 +168,8 @@ class Contour:
                     x -= self.delta  # a zero-length piece: this pass is done
                     break
                 out.feed(complex(z, here.imag))
-                scale = min(1.0, distance / 2 / self.escape.real)
+                # R0: no escape (rs274's distance / 2 / 0 is inf or NaN, and std::min makes either 1)
+                scale = min(1.0, distance / 2 / self.escape.real) if self.escape.real else 1.0
                 out.rapid(complex(z, here.imag) + scale * self.escape)
                 out.rapid(here - (scale * self.escape).conjugate())
                 (out.rapid if k == 0 else out.feed)(here)
