@@ -85,7 +85,11 @@ def child(tool: str, path: str) -> dict:
 
 
 def _held_mb() -> float:
-    """The resident set size, MB, after a garbage collection and (on glibc) the heap's free pages handed back."""
+    """The resident set size, MB, after a garbage collection and (on glibc) the heap's free pages handed back.
+
+    ``gcodekit.memory.release_freed_memory`` does the same, but importing
+    gcodekit (and NumPy) would add to the loop's runtime what it never used.
+    """
     import ctypes
     import gc
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..growing import GrowingColumn
-from .table import CommandTable, DecimalColumn, SparseColumn, decimal_units, fewest_places
+from .table import CommandTable, DecimalColumn, SparseColumn, fewest_units, scale_units
 
 __all__ = ["TableJoiner"]
 
@@ -51,27 +51,14 @@ class _Param:
             return
         values = col.dense() if isinstance(col, SparseColumn) else col
         if self.places is not None:
-            units = decimal_units(values, self.places)
-            if units is None:
-                places = fewest_places(values, self.places + 1)
-                units = None if places is None or not self._scale_units(places) else decimal_units(values, places)
-            if units is not None:
-                self.dense.append(units)
+            found = fewest_units(values, self.places)
+            if found is not None and (found[0] == self.places
+                                      or scale_units(self.dense.values(), self.places, found[0])):
+                self.places = found[0]
+                self.dense.append(found[1])
                 return
             self._to_floats()
         self.dense.append(values)
-
-    def _scale_units(self, places: int) -> bool:
-        """The units kept so far rescaled to ``places`` decimals (the same values), or False where one
-        would pass int32."""
-        assert self.dense is not None and self.places is not None
-        units, factor = self.dense.values(), 10 ** (places - self.places)
-        given = units != DecimalColumn.NO_WORD
-        if given.any() and np.abs(units[given].astype(np.int64)).max() * factor >= 2 ** 31 - 1:
-            return False
-        units[given] *= factor
-        self.places = places
-        return True
 
     def _to_floats(self) -> None:
         """From decimal units to floats, for a word they cannot give back."""

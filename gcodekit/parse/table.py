@@ -139,29 +139,41 @@ class DecimalColumn:
 
         None when some value needs more than ``max_places`` decimals or more
         than int32 units, or is -0.0 or infinite (program arithmetic gives
-        such values; written words rarely do).  Checked ``block`` values at
-        a time, so the check holds no second copy of a long column.
+        such values; written words rarely do).  Encoded ``block`` values at
+        a time, as the table joiner encodes chunks (the units so far scaled
+        when a block needs more places), so no second float copy is made.
         """
         values = np.asarray(values)
         if values.dtype != np.float64 or values.ndim != 1:
             return None
-        places = fewest_places(values[:4096], 0, max_places)
-        while places is not None and places <= max_places:
-            units = np.empty(values.size, np.int32)
-            for lo in range(0, values.size, block):
-                part = decimal_units(values[lo:lo + block], places)
-                if part is None:
-                    break
-                units[lo:lo + block] = part
-            else:
-                return cls(units, places)
-            places += 1
-        return None
+        units, places = np.empty(values.size, np.int32), 0
+        for lo in range(0, values.size, block):
+            found = fewest_units(values[lo:lo + block], places, max_places)
+            if found is None or (found[0] > places and not scale_units(units[:lo], places, found[0])):
+                return None
+            places, units[lo:lo + block] = found
+        return cls(units, places)
 
 
-def fewest_places(values: np.ndarray, start: int = 0, max_places: int = 6) -> int | None:
-    """The fewest decimal places, from ``start``, at which :func:`decimal_units` takes ``values``, or None."""
-    return next((k for k in range(start, max_places + 1) if decimal_units(values, k) is not None), None)
+def fewest_units(values: np.ndarray, start: int = 0, max_places: int = 6) -> tuple[int, np.ndarray] | None:
+    """The fewest decimal places from ``start`` at which :func:`decimal_units` takes ``values``, and the units;
+    None when no number of places up to ``max_places`` does."""
+    for places in range(start, max_places + 1):
+        units = decimal_units(values, places)
+        if units is not None:
+            return places, units
+    return None
+
+
+def scale_units(units: np.ndarray, places: int, to: int) -> bool:
+    """Rewrite ``units`` at ``places`` decimals in place at ``to`` places (the same values); False, and
+    nothing written, where one would pass int32."""
+    given = units != DecimalColumn.NO_WORD
+    factor = 10 ** (to - places)
+    if given.any() and np.abs(units[given].astype(np.int64)).max() * factor >= 2 ** 31 - 1:
+        return False
+    units[given] *= factor
+    return True
 
 
 def decimal_units(values: np.ndarray, places: int) -> np.ndarray | None:
@@ -265,9 +277,11 @@ class CommandTable:
     def comment_of(self, i: int) -> str | None:
         """Comment text of row ``i`` (several comments joined by a space), or None."""
         lo, hi = np.searchsorted(self.comment_rows, [i, i + 1])
-        if lo == hi:
-            return None
-        return " ".join(self.comment(k) for k in range(lo, hi))
+        return self._comments(int(lo), int(hi))
+
+    def _comments(self, lo: int, hi: int) -> str | None:
+        """Comments ``lo:hi`` joined by a space, or None when there are none."""
+        return None if lo == hi else " ".join(self.comment(k) for k in range(lo, hi))
 
     def comment(self, k: int) -> str:
         a, b = self.comment_offsets[k], self.comment_offsets[k + 1]
@@ -302,9 +316,7 @@ class CommandTable:
         out = []
         for j in range(stop - start):
             params = {letter: v for letter, values in columns if (v := values[j]) == v}
-            lo, hi = bounds[j], bounds[j + 1]
-            comment = None if lo == hi else " ".join(self.comment(k) for k in range(lo, hi))
-            out.append(self._command(start + j, params, comment))
+            out.append(self._command(start + j, params, self._comments(bounds[j], bounds[j + 1])))
         return out
 
     def _command(self, i: int, params: dict[str, float], comment: str | None) -> Command:
