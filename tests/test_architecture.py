@@ -20,7 +20,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "gcodekit"
 #: The stages in order; a module's stage is the longest prefix that names it.
 STAGES: list[tuple[str, ...]] = [
     ("gcodekit.errors", "gcodekit.limits", "gcodekit.units", "gcodekit.schema", "gcodekit.memory", "gcodekit.jit",
-     "gcodekit.growing", "gcodekit.lathe_profile", "gcodekit.tool_shapes"),
+     "gcodekit.growing", "gcodekit.columns", "gcodekit.lathe_profile", "gcodekit.tool_shapes"),
     ("gcodekit.syntax",),
     ("gcodekit.preprocess",),
     ("gcodekit.read",),

@@ -21,6 +21,7 @@ from gcodekit.growing import GrowingColumn
 from gcodekit.parse import GcodeParser
 from gcodekit.parse.join import TableJoiner
 from gcodekit.parse.table import CommandTable, DecimalColumn, SparseColumn
+from gcodekit.columns import RunColumn, Waypoints
 from gcodekit.pipeline.assemble import WaypointJoiner
 from gcodekit.read import read_text
 from gcodekit.syntax import load_flavor
@@ -64,19 +65,12 @@ def _joined_at_the_end(parts: list[dict], sizes: list[int]) -> dict:
     if len(parts) == 1:
         return parts[0]
     shift = np.cumsum([0] + sizes[:-1])
-    out = {}
-    for key in parts[0]:
-        cols = [p[key] for p in parts]
-        if key == "command":
-            out[key] = np.concatenate([c + np.int32(s) for c, s in zip(cols, shift)])
-            continue
-        first = cols[0][0] if cols[0].size else None
-        if first is not None and all(c.strides == (0,) for c in cols) and all(
-                c[0] == first or (c[0] != c[0] and first != first) for c in cols if c.size):
-            out[key] = np.broadcast_to(first, (sum(c.size for c in cols),))
-        else:
-            out[key] = np.concatenate(cols)
-    return out
+    return {key: np.concatenate([p[key] + np.int32(s) for p, s in zip(parts, shift)] if key == "command"
+                                else [p[key] for p in parts]) for key in parts[0]}
+
+
+def _bits(values) -> np.ndarray:
+    return np.ascontiguousarray(values).view(np.uint8)  # -0.0 is not 0.0, NaN payloads count
 
 
 values = st.sampled_from([0.0, -0.0, 1.5, np.nan, 2.0])
@@ -90,6 +84,21 @@ def _part(size: int, constant: bool, value: float, other: float) -> dict:
             "command": np.arange(size, dtype=np.int32)}
 
 
+def _check_joined(got, expected: dict) -> None:
+    """``got`` holds ``expected``'s columns bit for bit; a column of one value is a zero-stride view, one
+    of few runs is stored as its runs."""
+    assert list(got) == list(expected)
+    for key in expected:
+        kept = got.stored(key) if isinstance(got, Waypoints) else got[key]
+        assert kept.dtype == expected[key].dtype and got[key].dtype == expected[key].dtype, key
+        one_value = key != "command" and expected[key].size and np.unique(_bits(expected[key]).reshape(
+            expected[key].size, -1), axis=0).shape[0] == 1
+        if isinstance(got, Waypoints) and one_value:
+            assert isinstance(kept, np.ndarray) and kept.strides == (0,), key
+        assert isinstance(got[key], np.ndarray)
+        np.testing.assert_array_equal(_bits(got[key]), _bits(expected[key]))
+
+
 @settings(max_examples=300, deadline=None)
 @given(st.lists(chunk, min_size=1, max_size=6), st.lists(st.integers(0, 4), min_size=6, max_size=6))
 def test_waypoints_joined_as_they_come_are_the_ones_joined_at_the_end(chunks, extra_rows):
@@ -98,14 +107,30 @@ def test_waypoints_joined_as_they_come_are_the_ones_joined_at_the_end(chunks, ex
     joiner = WaypointJoiner()
     for p, rows in zip(parts, sizes):
         joiner.add({k: v.copy() if v.strides != (0,) and v.size else v for k, v in p.items()}, rows)
-    got, expected = joiner.finish(), _joined_at_the_end(parts, sizes)
-    assert list(got) == list(expected)
-    for key in expected:
-        assert got[key].dtype == expected[key].dtype, key
-        if expected[key].size:
-            assert (got[key].strides == (0,)) == (expected[key].strides == (0,)), key
-        bits = [np.ascontiguousarray(a).view(np.uint8) for a in (got[key], expected[key])]  # -0.0 is not 0.0
-        np.testing.assert_array_equal(*bits)
+    _check_joined(joiner.finish(), _joined_at_the_end(parts, sizes))
+
+
+def test_waypoints_of_few_runs_are_kept_as_runs_and_of_many_as_arrays():
+    """A print's feed (a few values, long runs) is kept as runs; positions (a new value each) as an array,
+    also when the first chunks looked like runs; a column whose dtype changes becomes one array."""
+    rng = np.random.default_rng(7)
+    sizes, parts = [3000, 50_000, 50_000, 40_000], []
+    for k, n in enumerate(sizes):
+        parts.append({
+            "x": np.zeros(n) if k == 0 else rng.normal(size=n),  # one value, then a new one each
+            "feed": np.repeat(rng.choice([1800.0, 600.0, -0.0, 0.0, np.nan], size=n // 100 + 1), 100)[:n],
+            "flow": np.broadcast_to(np.float32(0.5 if k < 3 else 0.25), (n,)),
+            "tool": np.full(n, 1, np.int32) if k < 2 else np.full(n, 2, np.int64),
+            "command": np.arange(n, dtype=np.int32)})
+    joiner = WaypointJoiner()
+    for p, n in zip(parts, sizes):
+        joiner.add(p, n + 5)
+    got, expected = joiner.finish(), _joined_at_the_end(parts, [n + 5 for n in sizes])
+    assert isinstance(got, Waypoints)
+    assert isinstance(got.stored("feed"), RunColumn) and isinstance(got.stored("flow"), RunColumn)
+    assert got.stored("feed").nbytes < expected["feed"].nbytes / 50
+    assert type(got.stored("x")) is np.ndarray and type(got.stored("tool")) is np.ndarray
+    _check_joined(got, expected)
 
 
 @pytest.mark.parametrize("n", [0, 1])

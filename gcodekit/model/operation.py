@@ -18,11 +18,12 @@ from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Sequence
+from collections.abc import MutableMapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..columns import Waypoints
 from ..errors import Diagnostics
 from ..limits import MAX_MOTIONS
 from ..parse.commands import Command, Kind
@@ -85,13 +86,13 @@ class Operation:
         self.plan: tuple[PlannedMoves, PlanResult] | None = None  # once a motion planner has run
 
     @property
-    def waypoints(self) -> dict[str, np.ndarray] | None:
-        """The waypoint columns (see :attr:`columns`); None before emulation."""
+    def waypoints(self) -> Waypoints | None:
+        """The waypoint columns (see :attr:`columns`), each read as an array; None before emulation."""
         return self._waypoints
 
     @waypoints.setter
-    def waypoints(self, columns: dict[str, np.ndarray] | None) -> None:
-        self._waypoints = columns
+    def waypoints(self, columns: MutableMapping[str, np.ndarray] | None) -> None:
+        self._waypoints = columns if columns is None or isinstance(columns, Waypoints) else Waypoints(columns)
         self._derived.clear()  # layers, features ... belong to the old columns
 
     # -- derived columns, computed once --------------------------------------------

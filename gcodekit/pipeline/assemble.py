@@ -9,6 +9,7 @@ import numpy as np
 from ..emulate.machine import Machine
 from ..emulate.presets import MachineConfig
 from ..errors import Diagnostics, GcodeError
+from ..columns import Column, RunColumn, Waypoints, run_starts, same_bits
 from ..growing import GrowingColumn
 from ..limits import PLAUSIBLE_TIME_S, Limits
 from ..model.operation import Operation
@@ -47,12 +48,14 @@ def empty_table(parser: GcodeParser, program: Program) -> CommandTable:
 class WaypointJoiner:
     """The waypoint columns of a program's chunks, joined as each chunk is emulated.
 
-    Gives what joining them all at the end would: a single chunk's columns
-    as they are; otherwise each column in one array (a
-    :class:`~gcodekit.growing.GrowingColumn`: no second copy of the
-    program's columns, no page touched twice), or a zero-stride view of the
-    first chunk's value when every chunk holds one value equal to it, and
-    ``command`` counting the rows of the whole program.
+    Gives what joining them all at the end would, value for value: a single
+    chunk's columns as they are; otherwise, in a :class:`~.columns.Waypoints`
+    mapping, each column either as its runs of equal values (a
+    :class:`~.columns.RunColumn`, while it has few: a print's feed, layer
+    height and flow), a zero-stride view where the whole column is one value,
+    or one array (a :class:`~gcodekit.growing.GrowingColumn`: no second copy
+    of the program's columns, no page touched twice), with ``command``
+    counting the rows of the whole program.
     """
 
     def __init__(self) -> None:
@@ -61,8 +64,7 @@ class WaypointJoiner:
         self._rows = 0  # command rows of the chunks joined so far
         self._size = 0  # their waypoints
         self._columns: dict[str, GrowingColumn] = {}
-        #: key -> (value, waypoints) of each chunk so far, while all are zero-stride views of equal values
-        self._constant: dict[str, list[tuple[np.generic, int]]] = {}
+        self._runs: dict[str, _Runs] = {}  # the columns kept as runs so far
 
     def add(self, part: dict[str, np.ndarray], rows: int) -> None:
         """The next chunk's columns (its ``command`` counting from 0) and its number of command rows."""
@@ -72,7 +74,7 @@ class WaypointJoiner:
         if self._first is not None:  # a second chunk: from now on, joined
             (first, first_rows), self._first = self._first, None
             self._keys = list(first)
-            self._constant = {k: [] for k in self._keys if k != "command" and first[k].size}
+            self._runs = {k: _Runs(first[k].dtype) for k in self._keys if k != "command"}
             self._take(first, first_rows)
         self._take(part, rows)
 
@@ -82,15 +84,12 @@ class WaypointJoiner:
             if key == "command":
                 self._column(key, col.dtype).append(col + np.int32(self._rows))  # int32: max_motions bounds the rows
                 continue
-            runs = self._constant.get(key)
-            if runs is not None and col.strides == (0,) and (not col.size or not runs or _same(col[0], runs[0][0])):
-                runs.append((col[0] if col.size else runs[0][0], col.size))
+            runs = self._runs.get(key)
+            if runs is not None and runs.add(col):
                 continue
-            if runs is not None:  # no longer one value: the chunks so far written out, each with its own
-                del self._constant[key]
-                column = self._column(key, np.result_type(col.dtype, *(value.dtype for value, _ in runs)))
-                for value, count in runs:
-                    column.fill(value, count)
+            if runs is not None:  # too many runs to be worth keeping: the values so far written out
+                del self._runs[key]
+                self._column(key, runs.dtype).append(np.asarray(runs.finish()))
             self._column(key, col.dtype).append(col)
         self._size += part["command"].size
         self._rows += rows
@@ -101,20 +100,54 @@ class WaypointJoiner:
             column = self._columns[key] = GrowingColumn(dtype)
         return column
 
-    def finish(self) -> dict[str, np.ndarray]:
+    def finish(self) -> dict[str, np.ndarray] | Waypoints:
         """The joined columns (the joiner is spent)."""
         if self._first is not None:
             return self._first[0]
-        out = {}
+        out: dict[str, Column] = {}
         for key in self._keys:
-            runs = self._constant.get(key)
-            out[key] = np.broadcast_to(runs[0][0], (self._size,)) if runs is not None else self._columns[key].finish()
-        return out
+            runs = self._runs.get(key)
+            out[key] = runs.finish() if runs is not None else self._columns[key].finish()
+        return Waypoints(out)
 
 
-def _same(value, first) -> bool:
-    """Equal, or both NaN."""
-    return bool(value == first or (value != value and first != first))
+class _Runs:
+    """A column's runs of bitwise equal values, chunk by chunk, while there are few of them."""
+
+    #: Kept as runs while there are at most this many values per run on average (or a few runs in all)
+    MIN_VALUES_PER_RUN = 8
+    FEW_RUNS = 1024
+
+    def __init__(self, dtype: np.dtype):
+        self.dtype = np.dtype(dtype)
+        self.starts = GrowingColumn(np.int64)
+        self.values = GrowingColumn(self.dtype)
+        self.size = 0
+
+    def add(self, col: np.ndarray) -> bool:
+        """Take the chunk's values as runs; False (nothing taken) when the column has too many runs for that,
+        or the chunk's dtype is not the column's."""
+        if col.dtype != self.dtype:
+            return False
+        starts = run_starts(col)
+        n_runs = len(self.values) + starts.size
+        if n_runs > self.FEW_RUNS and n_runs * self.MIN_VALUES_PER_RUN > self.size + col.size:
+            return False
+        if starts.size and len(self.values) and same_bits(self.values.values()[-1], col[0]):
+            starts = starts[1:]  # the chunk goes on with the last run's value
+        self.starts.append(starts + self.size)
+        self.values.append(col[starts])
+        self.size += col.size
+        return True
+
+    def finish(self) -> Column:
+        """The column: a zero-stride view of a lone value, else its runs (start indices as int32 when they fit)."""
+        starts, values = self.starts.finish(), self.values.finish()
+        if values.size == 1:
+            return np.broadcast_to(values[0], (self.size,))
+        if self.size < 2**31:
+            starts = starts.astype(np.int32)
+        return RunColumn(starts, values, self.size)
 
 
 def raise_first_run(op: Operation, program: Program, reading_error: GcodeError | None) -> None:

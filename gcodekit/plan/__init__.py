@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, Iterator, Mapping
 
 import numpy as np
 
+from ..columns import stored
 from ..errors import ConfigError, did_you_mean
 from .moves import PlannedMoves, PlannerMoves, PlanResult
 from .trapezoids import TrapezoidPlan
@@ -110,8 +111,9 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
     # where the emulator knew none either; nor has a move a planner gave no speed at all (a printer's G0 at
     # F0): unknown, as the emulator has it.  The emulator times F0 where the firmware moves at a minimum
     # speed it knows (RepRapFirmware's M203 I), and then the planner's crawl is the firmware's.
-    unknown = (np.asarray(w["motion"]) >= 2) & ~(np.asarray(w["feed"], float) > 0) & (np.asarray(w["distance"]) > 0)
-    unknown &= ~np.isfinite(np.asarray(w["time"], float))
+    unknown = np.flatnonzero((np.asarray(w["motion"]) >= 2) & (np.asarray(w["distance"]) > 0)
+                             & ~np.isfinite(np.asarray(w["time"], float)))
+    unknown = unknown[~(np.asarray(stored(w, "feed")[unknown], float) > 0)]  # read where needed: runs stay runs
     times[unknown] = np.nan
     times[np.isinf(times)] = np.nan
     return times

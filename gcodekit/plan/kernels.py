@@ -215,8 +215,8 @@ def _classic_jerk(dx, dy, dz, de, speed_per_mm, nominal_speed, jx, jy, jz, je, r
     return vmax
 
 
-def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, speed_v, row, by_waypoint, feed,
-                   command, motion, rapid_v, factor, flush, limit_rows,
+def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, summing, idx, chained, speed_v, row, by_waypoint,
+                   feed, feed_runs, command, motion, rapid_v, factor, flush, limit_rows,
                    max_velocity, max_accel, square_corner_velocity, minimum_cruise_ratio, initial, z_velocity, z_accel,
                    e_velocity, e_accel, corner_velocity, extrude_only_accel, no_limit_v2):
     """:func:`.klipper._move_block` over all moves: Move.__init__, limit_speed and calc_junction.
@@ -226,7 +226,10 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, 
     :class:`.points.MoveEnds` takes them, ``chained`` or not); with
     ``summing``, ``we`` holds each waypoint's extrusion and the extruder
     position is its running sum, added up here in ``np.cumsum``'s order as
-    the waypoints come (they only grow).  The limits
+    the waypoints come (they only grow).  ``wz`` and ``feed`` may be stored
+    as runs (:class:`gcodekit.columns.RunColumn`): then ``wz_runs`` and
+    ``feed_runs`` hold where each run starts and the columns their values
+    (empty, the columns are read as they are).  The limits
     in force come from ``limit_rows`` (sorted) and their columns,
     ``initial`` (max_velocity, max_accel, square_corner_velocity,
     minimum_cruise_ratio) before the first, as :func:`.moves.in_force`.
@@ -249,13 +252,21 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, 
     j = 0  # limit rows before the move's row
     e_at = -1  # with summing: the waypoint the running sum e_sum has reached
     e_sum = 0.0
+    z_at = feed_at = 0  # with runs: the run of wz and of feed the last move read
     p_kinematic = False
     p_e_r = p_r0 = p_r1 = p_r2 = p_jd = 0.0
     for i in range(n):
         if by_waypoint:
             w = idx[i]
             r = command[w]
-            speed = feed[w] / 60.0
+            if feed_runs.size:  # the run holding w: the cursor moves on (back, a search afresh)
+                if w < feed_runs[feed_at]:
+                    feed_at = np.searchsorted(feed_runs, w, side="right") - 1
+                while feed_at + 1 < feed_runs.size and feed_runs[feed_at + 1] <= w:
+                    feed_at += 1
+                speed = feed[feed_at] / 60.0
+            else:
+                speed = feed[w] / 60.0
             if rapid_v == rapid_v and motion[w] == MOTION_RAPID:
                 speed = rapid_v
             if factor.size:
@@ -289,10 +300,25 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, we, summing, idx, chained, 
             else:
                 e_v = we[v] if v >= 0 else 0.0
                 e_w = we[w]
-            if v < 0:
-                dx, dy, dz, de = wx[w] - 0.0, wy[w] - 0.0, wz[w] - 0.0, e_w - 0.0
+            if wz_runs.size:  # the runs holding v, then w (v < w)
+                z_v = 0.0
+                if v >= 0:
+                    if v < wz_runs[z_at]:
+                        z_at = np.searchsorted(wz_runs, v, side="right") - 1
+                    while z_at + 1 < wz_runs.size and wz_runs[z_at + 1] <= v:
+                        z_at += 1
+                    z_v = wz[z_at]
+                if w < wz_runs[z_at]:
+                    z_at = np.searchsorted(wz_runs, w, side="right") - 1
+                while z_at + 1 < wz_runs.size and wz_runs[z_at + 1] <= w:
+                    z_at += 1
+                z_w = wz[z_at]
             else:
-                dx, dy, dz, de = wx[w] - wx[v], wy[w] - wy[v], wz[w] - wz[v], e_w - e_v
+                z_w, z_v = wz[w], wz[v] if v >= 0 else 0.0
+            if v < 0:
+                dx, dy, dz, de = wx[w] - 0.0, wy[w] - 0.0, z_w - 0.0, e_w - 0.0
+            else:
+                dx, dy, dz, de = wx[w] - wx[v], wy[w] - wy[v], z_w - z_v, e_w - e_v
         else:
             dx = end[i, 0] - start[i, 0]
             dy = end[i, 1] - start[i, 1]

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..columns import Column, RunColumn
 from ..errors import ConfigError
 from ..memory import release_freed_memory
 from .kernels import engine
@@ -261,21 +262,21 @@ def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict,
     ends = getattr(moves.start, "ends", None)  # a MoveEnds when the points are gathered from the waypoints
     if ends is None:
         points = (np.ascontiguousarray(moves.start, float), np.ascontiguousarray(moves.end, float), False,
-                  *([np.zeros(0)] * 4), False, np.zeros(0, np.int32), False)
+                  *([np.zeros(0)] * 3), NO_RUNS, np.zeros(0), False, np.zeros(0, np.int32), False)
     else:  # the extruder's running sum made as the loop goes, when it is not made already
         x, y, z, e = ends.columns
         summing = isinstance(e, RunningSum)
         e = e.deltas if summing else e
-        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, *(np.asarray(c, float) for c in (x, y, z, e)), summing,
-                  ends.idx, ends.chained)
+        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, np.asarray(x, float), np.asarray(y, float), *_runs(z),
+                  np.asarray(e, float), summing, ends.idx, ends.chained)
     if ends is not None and moves.read_from_source:  # each move's speed and row read at its waypoint, in the loop
         src = moves.source
-        speeds_and_rows = (np.zeros(0), np.zeros(0, np.int32), True, np.asarray(src.feed, float), src.command,
+        speeds_and_rows = (np.zeros(0), np.zeros(0, np.int32), True, *_runs(src.feed), src.command,
                            src.motion, np.nan if src.rapid_v is None else float(src.rapid_v),
                            np.zeros(0) if src.factor is None else np.asarray(src.factor, float))
     else:
         speeds_and_rows = (np.ascontiguousarray(moves.speed_v, float), np.ascontiguousarray(moves.row), False,
-                           np.zeros(0), np.zeros(0, np.int32), np.zeros(0, np.uint8), np.nan, np.zeros(0))
+                           np.zeros(0), NO_RUNS, np.zeros(0, np.int32), np.zeros(0, np.uint8), np.nan, np.zeros(0))
     out = compiled.klipper_moves(
         *points, *speeds_and_rows, flush,
         np.ascontiguousarray(rows, np.int64), *(np.ascontiguousarray(limits[k], float) for k in names),
@@ -283,6 +284,17 @@ def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict,
         float(config.max_z_accel or config.max_accel), float(config.max_e_velocity), float(config.max_e_accel),
         float(config.instantaneous_corner_velocity), EXTRUDE_ONLY_ACCEL, NO_LIMIT_V2)
     return dict(zip(("move_d", "accel", "max_cruise_v2", "delta_v2", "mcr_delta_v2", "cap"), out[:6])), out[6]
+
+
+NO_RUNS = np.zeros(0, np.int64)  # a column read as it is
+
+
+def _runs(column: Column) -> tuple[np.ndarray, np.ndarray]:
+    """A column as the compiled loop reads it: its values, and where its runs start (:data:`NO_RUNS` for an
+    array)."""
+    if isinstance(column, RunColumn):
+        return np.asarray(column.values, float), column.starts.astype(np.int64)
+    return np.asarray(column, float), NO_RUNS
 
 
 def _move_block(moves, rows, limits, config, flush, lo, hi, m, junction) -> None:

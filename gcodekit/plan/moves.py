@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
+from ..columns import Column, stored
 from ..emulate import arcs
 from ..parse.table import MOTION_RAPID, NAME_ID, in_ids
 from .kernels import engine
@@ -40,7 +41,7 @@ class MoveSource:
     3 M-move print), and read the values again, bit for bit, when asked.
     """
 
-    feed: np.ndarray
+    feed: Column  # read at the moves' waypoints only: a column stored as runs stays so
     command: np.ndarray
     motion: np.ndarray
     rapid_v: float | None
@@ -50,7 +51,7 @@ class MoveSource:
     def speed_v(self, waypoint: np.ndarray) -> np.ndarray:
         """Requested speed (mm/s) of the moves of ``waypoint``: the feed over 60 (G0 at ``rapid_v`` when it is
         not the feed), times the speed factor."""
-        speed = np.asarray(self.feed, float)[waypoint] / 60.0
+        speed = np.asarray(self.feed[waypoint], float) / 60.0
         if self.rapid_v is not None:  # G0 at the machine's rapid rate (Sailfish), as the emulator times it
             speed[self.motion[waypoint] == MOTION_RAPID] = self.rapid_v
         if self.factor is not None:
@@ -392,8 +393,8 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     compiled = engine(n)
     e = np.cumsum(w["de"]) if compiled is None else None
     if compiled is not None:  # the same moves and points in one loop, without the temporaries below
-        idx, start, end, is_chained = compiled.move_points(w["x"], w["y"], w["z"], w["de"], w["motion"], homing,
-                                                           w["distance"], not gathered)
+        idx, start, end, is_chained = compiled.move_points(w["x"], w["y"], np.asarray(stored(w, "z")), w["de"],
+                                                           w["motion"], homing, w["distance"], not gathered)
         idx = _narrow(idx, n)
     else:
         columns = (w["x"], w["y"], w["z"], e)
@@ -407,14 +408,14 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
         is_chained = chained(columns, idx)
     del homing
     rapids_at_feed = op.machine.rapids_at_feed(op.flavor is None or op.flavor.rapid_is_feed)
-    source = MoveSource(w["feed"], rows, w["motion"], None if rapids_at_feed else op.machine.rapid_feed / 60.0,
+    source = MoveSource(stored(w, "feed"), rows, w["motion"], None if rapids_at_feed else op.machine.rapid_feed / 60.0,
                         speed_factor, len(op.table))
     is_arc = w["motion"][idx] >= 3
     segmenting = arc_segments is not None and bool(is_arc.any())
     # gathered, the planner reads the speeds and rows a block at a time too: two arrays fewer at its peak
     speed, rows = (None, None) if gathered and not segmenting else (source.speed_v(idx), source.row(idx))
     if gathered or compiled is None:  # the points from the waypoint columns: gathered when asked, else stored
-        ends = MoveEnds((w["x"], w["y"], w["z"], RunningSum(w["de"], e)), idx, is_chained)
+        ends = MoveEnds((w["x"], w["y"], stored(w, "z"), RunningSum(w["de"], e)), idx, is_chained)
         start, end = (ends.start, ends.end) if gathered and not segmenting else ends.arrays()
         del ends, e
     if not segmenting:

@@ -1,0 +1,179 @@
+"""Waypoint columns kept as their runs of equal values, and the mapping that gives them as arrays.
+
+A large print's feed rate, layer height and flow change a few thousand
+times over millions of waypoints.  Stored as their runs (where each run
+starts, and its value), such a column takes a few hundred kilobytes
+instead of 25 MB.  :class:`Waypoints` is the mapping an operation keeps
+its columns in: reading a column gives it as an array, decoded on the
+first read and kept so from then on; :meth:`Waypoints.stored` gives what
+is stored, which a planner reads a block of moves at a time without
+decoding the whole column.  Values come back bit for bit (runs are
+compared by their bits: ``-0.0`` and each NaN are their own values).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping, MutableMapping
+from typing import Union
+
+import numpy as np
+
+__all__ = ["RunColumn", "Waypoints", "Column", "stored", "same_bits", "run_starts"]
+
+
+class RunColumn:
+    """A column of ``size`` values stored as runs: run ``k`` holds ``values[k]`` from ``starts[k]`` on.
+
+    Indexed like a 1-D array (an int, a slice of step 1, indices or a
+    mask), it gives float or int values as an array would;
+    ``np.asarray`` gives the whole column.
+
+    Examples
+    --------
+    >>> col = RunColumn(np.array([0, 3]), np.array([1.5, 2.0]), 5)
+    >>> np.asarray(col).tolist(), col[2:4].tolist(), col[[4, 0]].tolist()
+    ([1.5, 1.5, 1.5, 2.0, 2.0], [1.5, 2.0], [2.0, 1.5])
+    """
+
+    def __init__(self, starts: np.ndarray, values: np.ndarray, size: int):
+        if starts.size != values.size or (size and (starts.size == 0 or starts[0] != 0)):
+            raise ValueError("runs need one value each, the first starting at 0")
+        self.starts, self.values, self.size = starts, values, int(size)
+
+    @property
+    def dtype(self) -> np.dtype:
+        return self.values.dtype
+
+    @property
+    def shape(self) -> tuple[int]:
+        return (self.size,)
+
+    @property
+    def ndim(self) -> int:
+        return 1
+
+    @property
+    def nbytes(self) -> int:
+        """The memory the runs take (an array of the values would take ``size * itemsize``)."""
+        return int(self.starts.nbytes + self.values.nbytes)
+
+    def __len__(self) -> int:
+        return self.size
+
+    def __repr__(self) -> str:
+        return f"RunColumn({self.size} values in {self.values.size} runs, {self.dtype})"
+
+    def _lengths(self, lo: int, hi: int) -> tuple[int, np.ndarray]:
+        """The first run reaching into ``[lo, hi)`` and how many of its values each run from it gives."""
+        first, last = np.searchsorted(self.starts, (lo, hi), side="right") - 1
+        bounds = np.clip(np.r_[self.starts[first + 1:last + 1], hi], lo, hi)
+        return int(first), np.diff(np.r_[lo, bounds])
+
+    def window(self, lo: int, hi: int) -> np.ndarray:
+        """The values ``lo`` to ``hi - 1`` as an array."""
+        hi = max(hi, lo)
+        if hi == lo:
+            return np.empty(0, self.dtype)
+        first, lengths = self._lengths(lo, hi)
+        return np.repeat(self.values[first:first + lengths.size], lengths)
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        out = self.window(0, self.size)
+        return out if dtype is None else out.astype(dtype, copy=False)
+
+    def __getitem__(self, index) -> np.ndarray | np.generic:
+        if isinstance(index, slice):
+            lo, hi, step = index.indices(self.size)
+            return self.window(lo, hi) if step == 1 else np.asarray(self)[index]
+        if isinstance(index, (int, np.integer)):
+            k = int(index) + (self.size if index < 0 else 0)
+            if not 0 <= k < self.size:
+                raise IndexError(f"index {int(index)} is out of bounds for a column of {self.size}")
+            return self.values[np.searchsorted(self.starts, k, side="right") - 1]
+        index = np.asarray(index)
+        if index.dtype == bool:
+            if index.shape != self.shape:
+                raise IndexError(f"a mask of {index.shape} for a column of {self.size}")
+            index = np.flatnonzero(index)
+        if index.size == 0:
+            return np.empty(index.shape, self.dtype)
+        index = np.where(index < 0, index + self.size, index)
+        lo, hi = int(index.min()), int(index.max()) + 1
+        if lo < 0 or hi > self.size:
+            raise IndexError(f"indices out of bounds for a column of {self.size}")
+        if hi - lo <= 4 * index.size:  # a block of nearby indices: the window, then gathered
+            return self.window(lo, hi)[index - lo]
+        return self.values[np.searchsorted(self.starts, index, side="right") - 1]
+
+
+#: What a waypoint column may be stored as.
+Column = Union[np.ndarray, RunColumn]
+
+
+def bits(values: np.ndarray) -> np.ndarray:
+    """The values' bit patterns as unsigned integers (a float's ``-0.0`` and NaN payloads kept apart)."""
+    values = np.ascontiguousarray(values)
+    return values.view(f"u{values.dtype.itemsize}") if values.dtype.kind in "fiub" else values
+
+
+def same_bits(a: np.generic, b: np.generic) -> bool:
+    """Whether two values of one dtype are the same bit for bit."""
+    return bool(bits(np.array([a]))[0] == bits(np.array([b], dtype=np.asarray(a).dtype))[0])
+
+
+def run_starts(values: np.ndarray) -> np.ndarray:
+    """Where each run of bitwise equal values begins (0 first), for a 1-D array with values."""
+    if values.strides == (0,) or values.size < 2:
+        return np.zeros(min(values.size, 1), np.int64)
+    b = bits(values)
+    return np.r_[0, np.flatnonzero(b[1:] != b[:-1]) + 1]
+
+
+class Waypoints(MutableMapping):
+    """An operation's waypoint columns by name: each read gives an array.
+
+    A column stored as runs (:class:`RunColumn`) is decoded on its first
+    read and kept as an array from then on, so a reader may write into it
+    as into any other; :meth:`stored` gives it undecoded.  ``columns`` is
+    kept, not copied: what is added to it shows here.
+    """
+
+    def __init__(self, columns: MutableMapping[str, Column] | None = None):
+        self._columns: MutableMapping[str, Column] = {} if columns is None else columns
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        column = self._columns[key]
+        if not isinstance(column, np.ndarray):
+            column = self._columns[key] = np.asarray(column)
+        return column
+
+    def __setitem__(self, key: str, column: Column) -> None:
+        self._columns[key] = column
+
+    def __delitem__(self, key: str) -> None:
+        del self._columns[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._columns)
+
+    def __len__(self) -> int:
+        return len(self._columns)
+
+    def __contains__(self, key: object) -> bool:
+        return key in self._columns
+
+    def __repr__(self) -> str:
+        return f"Waypoints({', '.join(self._columns)})"
+
+    def stored(self, key: str) -> Column:
+        """Column ``key`` as stored: an array, or a :class:`RunColumn` read by slices and indices."""
+        return self._columns[key]
+
+    def copy(self) -> "Waypoints":
+        """A new mapping of the same columns (the arrays are shared, as ``dict.copy`` shares its values)."""
+        return Waypoints(dict(self._columns))
+
+
+def stored(columns: Mapping[str, Column], key: str) -> Column:
+    """Column ``key`` of ``columns`` without decoding it (a plain mapping's value as it is)."""
+    return columns.stored(key) if isinstance(columns, Waypoints) else columns[key]
