@@ -40,6 +40,17 @@ class RunColumn:
             raise ValueError("runs need one value each, the first starting at 0")
         self.starts, self.values, self.size = starts, values, int(size)
 
+    @classmethod
+    def encode(cls, values: np.ndarray, min_values_per_run: int = 8) -> "Column":
+        """``values`` as runs when each run holds ``min_values_per_run`` values on average (a zero-stride view
+        for a lone value), else the array itself."""
+        starts = run_starts(values)
+        if starts.size <= 1:
+            return np.broadcast_to(values[0], values.shape) if values.size else values  # (no view of values)
+        if starts.size * min_values_per_run > values.size:
+            return values
+        return cls(starts.astype(np.int32) if values.size < 2**31 else starts, values[starts], values.size)
+
     @property
     def dtype(self) -> np.dtype:
         return self.values.dtype
@@ -106,7 +117,8 @@ class RunColumn:
         return self.values[np.searchsorted(self.starts, index, side="right") - 1]
 
 
-#: What a waypoint column may be stored as.
+#: What a waypoint column may be stored as (besides decimal units, :class:`gcodekit.parse.table.DecimalColumn`,
+#: which reads as these do).
 Column = Union[np.ndarray, RunColumn]
 
 

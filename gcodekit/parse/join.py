@@ -19,26 +19,68 @@ import numpy as np
 from ..growing import GrowingColumn
 from .table import CommandTable, DecimalColumn, SparseColumn, fewest_units, scale_units
 
-__all__ = ["TableJoiner"]
+__all__ = ["TableJoiner", "GrowingDecimals"]
 
 _COLUMNS = ("line", "kind", "letter", "number", "name", "motion")
 
 
+class GrowingDecimals:
+    """Float values appended in order, kept as decimal units (:class:`~.table.DecimalColumn`) while each
+    comes back from them bit for bit, and as floats from the first that does not.
+
+    A chunk needing more decimals scales the units kept so far in place; a
+    value no int32 unit holds (a computed value, a -0.0, past int32) turns
+    the column to floats for good.  NaN is kept (as ``NO_WORD`` in units).
+    """
+
+    def __init__(self) -> None:
+        self.column = GrowingColumn(np.int32)
+        self.places: int | None = 0  # None once the column holds floats
+
+    def __len__(self) -> int:
+        return len(self.column)
+
+    def append(self, values: np.ndarray) -> None:
+        if self.places is not None:
+            found = fewest_units(values, self.places)
+            if found is not None and (found[0] == self.places
+                                      or scale_units(self.column.values(), self.places, found[0])):
+                self.places = found[0]
+                self.column.append(found[1])
+                return
+            self._to_floats()
+        self.column.append(values)
+
+    def fill_missing(self, count: int) -> None:
+        """Add ``count`` NaN."""
+        self.column.fill(np.nan if self.places is None else DecimalColumn.NO_WORD, count)
+
+    def _to_floats(self) -> None:
+        assert self.places is not None
+        kept = DecimalColumn(self.column.finish(), self.places)
+        self.column, self.places = GrowingColumn(np.float64), None
+        self.column.append(kept.dense())
+
+    def finish(self) -> np.ndarray | DecimalColumn:
+        """The values: decimal units when every one holds, else floats (the column is empty afterwards)."""
+        values = self.column.finish()
+        return values if self.places is None else DecimalColumn(values, self.places)
+
+
 class _Param:
-    """One parameter letter across the chunks: sparse pieces until a chunk has it dense, then decimal
-    units (``places`` decimals) while they hold every word, floats after."""
+    """One parameter letter across the chunks: sparse pieces until a chunk has it dense, then
+    :class:`GrowingDecimals`."""
 
     def __init__(self) -> None:
         self.pieces: list[tuple[int, int, SparseColumn | None]] = []  # (first row, rows, column) while sparse
-        self.dense: GrowingColumn | None = None
-        self.places: int | None = None  # the dense column's decimal places; None once it holds floats
+        self.dense: GrowingDecimals | None = None
 
     def add(self, col: np.ndarray | SparseColumn | None, first_row: int, rows: int) -> None:
         if self.dense is None and not isinstance(col, np.ndarray):
             self.pieces.append((first_row, rows, col))
             return
         if self.dense is None:  # the first dense chunk: the earlier ones written out densely
-            self.dense, self.places = GrowingColumn(np.int32), 0
+            self.dense = GrowingDecimals()
             for _, size, piece in self.pieces:
                 self._add_dense(piece, size)
             self.pieces = []
@@ -47,30 +89,13 @@ class _Param:
     def _add_dense(self, col: np.ndarray | SparseColumn | None, rows: int) -> None:
         assert self.dense is not None
         if col is None:
-            self.dense.fill(np.nan if self.places is None else DecimalColumn.NO_WORD, rows)
-            return
-        values = col.dense() if isinstance(col, SparseColumn) else col
-        if self.places is not None:
-            found = fewest_units(values, self.places)
-            if found is not None and (found[0] == self.places
-                                      or scale_units(self.dense.values(), self.places, found[0])):
-                self.places = found[0]
-                self.dense.append(found[1])
-                return
-            self._to_floats()
-        self.dense.append(values)
-
-    def _to_floats(self) -> None:
-        """From decimal units to floats, for a word they cannot give back."""
-        assert self.dense is not None and self.places is not None
-        kept = DecimalColumn(self.dense.finish(), self.places)
-        self.dense, self.places = GrowingColumn(np.float64), None
-        self.dense.append(kept.dense())
+            self.dense.fill_missing(rows)
+        else:
+            self.dense.append(col.dense() if isinstance(col, SparseColumn) else col)
 
     def finish(self, n: int) -> np.ndarray | SparseColumn | DecimalColumn:
         if self.dense is not None:
-            values = self.dense.finish()
-            return values if self.places is None else DecimalColumn(values, self.places)
+            return self.dense.finish()
         given = [(first, c) for first, _, c in self.pieces if c is not None]
         return SparseColumn(np.concatenate([c.rows + np.int64(first) for first, c in given]),
                             np.concatenate([c.values for _, c in given]), n)

@@ -109,8 +109,29 @@ class DecimalColumn:
     def size(self) -> int:
         return int(self.units.size)
 
+    @property
+    def shape(self) -> tuple[int]:
+        return (self.size,)
+
+    @property
+    def dtype(self) -> np.dtype:
+        """The values' dtype (float64; the units are int32)."""
+        return np.dtype(np.float64)
+
+    @property
+    def ndim(self) -> int:
+        return 1
+
+    @property
+    def nbytes(self) -> int:
+        return int(self.units.nbytes)
+
     def __len__(self) -> int:
         return self.size
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        out = self.dense()
+        return out if dtype is None else out.astype(dtype, copy=False)
 
     def __getitem__(self, index) -> np.ndarray | float:
         """The values of the rows ``index`` (an int, a slice or indices), as float64."""

@@ -35,7 +35,7 @@ from ..model.filament import relative_e_suspect, stated_diameter
 from ..parse import GcodeParser
 from ..parse.join import TableJoiner
 from ..plan import machine_options as firmware_options
-from ..plan import planner_settings, run_planner
+from ..plan import planner_settings, run_planner, times_every_move, times_to_plan
 from ..read import Blocks
 from ..syntax import Flavor
 from .assemble import WaypointJoiner, empty_table, new_machine, raise_first_run, warn_implausible_time
@@ -154,6 +154,8 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
                 settings = _with_slicer_limits(op, settings, chosen=machine is not None)
             if bar is not None:
                 bar.set_postfix_str(f"planning ({config.planner})")
+            if times_every_move(config.planner):  # the plan replaces the other times: freed before it
+                op.waypoints["time"] = times_to_plan(op.waypoints)
             op.attach_plan(run_planner(op, config.planner, settings))
     finally:
         if bar is not None:

@@ -14,12 +14,13 @@ from ..growing import GrowingColumn
 from ..limits import PLAUSIBLE_TIME_S, Limits
 from ..model.operation import Operation
 from ..parse import CommandTable, GcodeParser
+from ..parse.join import GrowingDecimals
 from ..plan import planner_settings
 from ..read import Blocks
 from ..syntax import Flavor
 from .program import Program, quote_diagnostics
 
-__all__ = ["new_machine", "empty_table", "WaypointJoiner", "raise_first_run", "warn_implausible_time"]
+__all__ = ["new_machine", "empty_table", "WaypointJoiner", "WRITTEN", "raise_first_run", "warn_implausible_time"]
 
 
 def new_machine(flavor: Flavor, config: MachineConfig, diagnostics: Diagnostics, limits: Limits = Limits(),
@@ -45,6 +46,11 @@ def empty_table(parser: GcodeParser, program: Program) -> CommandTable:
     return parser.parse(Blocks.empty(program.name))
 
 
+#: The columns that hold the program's own numbers where it writes absolute positions (relative E too): kept
+#: as decimal units while every value comes back from them bit for bit (see :class:`.parse.join.GrowingDecimals`)
+WRITTEN = ("x", "y", "z", "a", "b", "c", "de")
+
+
 class WaypointJoiner:
     """The waypoint columns of a program's chunks, joined as each chunk is emulated.
 
@@ -53,9 +59,10 @@ class WaypointJoiner:
     mapping, each column either as its runs of equal values (a
     :class:`~.columns.RunColumn`, while it has few: a print's feed, layer
     height and flow), a zero-stride view where the whole column is one value,
-    or one array (a :class:`~gcodekit.growing.GrowingColumn`: no second copy
-    of the program's columns, no page touched twice), with ``command``
-    counting the rows of the whole program.
+    decimal units (the positions of :data:`WRITTEN`, while they hold them
+    bit for bit), or one array (a :class:`~gcodekit.growing.GrowingColumn`:
+    no second copy of the program's columns, no page touched twice), with
+    ``command`` counting the rows of the whole program.
     """
 
     def __init__(self) -> None:
@@ -94,10 +101,11 @@ class WaypointJoiner:
         self._size += part["command"].size
         self._rows += rows
 
-    def _column(self, key: str, dtype: np.dtype) -> GrowingColumn:
+    def _column(self, key: str, dtype: np.dtype) -> GrowingColumn | GrowingDecimals:
         column = self._columns.get(key)
         if column is None:
-            column = self._columns[key] = GrowingColumn(dtype)
+            written = key in WRITTEN and dtype == np.float64
+            column = self._columns[key] = GrowingDecimals() if written else GrowingColumn(dtype)
         return column
 
     def finish(self) -> dict[str, np.ndarray] | Waypoints:
@@ -180,10 +188,12 @@ def raise_first_run(op: Operation, program: Program, reading_error: GcodeError |
 def warn_implausible_time(op: Operation) -> None:
     """A warning, at its longest step, when the program would run longer than
     :data:`~gcodekit.limits.PLAUSIBLE_TIME_S` (a year): a runaway arc, dwell or feed, not a real job."""
-    time = np.nan_to_num(np.asarray(op.waypoints["time"], float))
-    total = float(time.sum())
+    time = np.asarray(op.waypoints["time"], float)
+    finite = np.isfinite(time)  # summed without a copy of the column: NaN counts as 0, inf as the largest float
+    total = float(np.sum(time, where=finite)) + (0.0 if finite.all() else float(np.nan_to_num(time[~finite]).sum()))
     if not total > PLAUSIBLE_TIME_S:
         return
+    time = np.nan_to_num(time)
     longest = int(np.argmax(time))
     row = int(op.waypoints["command"][longest])
     years = total / (365.25 * 86400.0)

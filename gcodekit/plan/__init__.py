@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, Iterator, Mapping
 
 import numpy as np
 
-from ..columns import stored
+from ..columns import Column, RunColumn, stored
 from ..errors import ConfigError, did_you_mean
 from .moves import PlannedMoves, PlannerMoves, PlanResult
 from .trapezoids import TrapezoidPlan
@@ -96,7 +96,7 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
     (RepRapFirmware takes F0 as written and does crawl at M203 I); a move
     planned at no speed (an infinite time) gets NaN as well.
     """
-    n = w["x"].size
+    n = len(stored(w, "x"))
     times = np.zeros(n)
     waypoint = moves.waypoint
     for sel in _whole_waypoints(waypoint):  # a block of moves at a time: no array of every move's duration
@@ -105,18 +105,43 @@ def waypoint_times(w: Mapping[str, np.ndarray], moves: PlannerMoves | PlannedMov
         times[first:first + summed.size] = summed
     has_moves = np.zeros(n, bool)
     has_moves[moves.waypoint] = True
-    idle = np.flatnonzero(~has_moves)
-    times[idle] = np.where(np.asarray(w["motion"])[idle] > 0, 0.0, np.asarray(w["time"])[idle])
-    # a feed move with no feed in force has no time a planner could know (its minimum speed is no answer)
-    # where the emulator knew none either; nor has a move a planner gave no speed at all (a printer's G0 at
-    # F0): unknown, as the emulator has it.  The emulator times F0 where the firmware moves at a minimum
-    # speed it knows (RepRapFirmware's M203 I), and then the planner's crawl is the firmware's.
-    unknown = np.flatnonzero((np.asarray(w["motion"]) >= 2) & (np.asarray(w["distance"]) > 0)
-                             & ~np.isfinite(np.asarray(w["time"], float)))
-    unknown = unknown[~(np.asarray(stored(w, "feed")[unknown], float) > 0)]  # read where needed: runs stay runs
-    times[unknown] = np.nan
+    # the columns read a block of waypoints at a time: those kept as runs stay so, no column is copied whole
+    motion, distance, time, feed = (stored(w, k) for k in ("motion", "distance", "time", "feed"))
+    for lo in range(0, n, 1 << 16):
+        sl = slice(lo, min(lo + (1 << 16), n))
+        block_motion, block_time, block_times = np.asarray(motion[sl]), np.asarray(time[sl], float), times[sl]
+        idle = ~has_moves[sl]
+        block_times[idle] = np.where(block_motion[idle] > 0, 0.0, block_time[idle])
+        # a feed move with no feed in force has no time a planner could know (its minimum speed is no
+        # answer) where the emulator knew none either; nor has a move a planner gave no speed at all (a
+        # printer's G0 at F0): unknown, as the emulator has it.  The emulator times F0 where the firmware
+        # moves at a minimum speed it knows (RepRapFirmware's M203 I), and then the planner's crawl is the
+        # firmware's.
+        unknown = (block_motion >= 2) & ~(np.asarray(feed[sl], float) > 0) & (np.asarray(distance[sl]) > 0)
+        unknown &= ~np.isfinite(block_time)
+        block_times[unknown] = np.nan
     times[np.isinf(times)] = np.nan
     return times
+
+
+def times_every_move(name: str) -> bool:
+    """Whether planner ``name`` times every move itself, reading the emulator's times only where nothing
+    moves and where they are unknown (its module's ``TIMES_EVERY_MOVE``; see :func:`times_to_plan`)."""
+    return bool(getattr(importlib.import_module(PLANNERS[name][0]), "TIMES_EVERY_MOVE", False))
+
+
+def times_to_plan(w: Mapping[str, np.ndarray]) -> Column:
+    """The emulator's ``time`` column as a planner that times every move reads it (:func:`times_every_move`).
+
+    Such a plan gives every moving waypoint its time (:func:`waypoint_times`),
+    so the emulator's finite times of moves are dropped (as 0) and what stays
+    is the time of each waypoint that does not move (a dwell) and the NaN of
+    each move the emulator could not time: on a print, a few runs instead of
+    25 MB of times the plan replaces, freed before the planner's own arrays.
+    """
+    time = np.asarray(w["time"], float)
+    replaced = (np.asarray(w["motion"]) > 0) & np.isfinite(time)
+    return RunColumn.encode(np.where(replaced, 0.0, time))
 
 
 def _whole_waypoints(waypoint: np.ndarray, size: int = 1 << 16) -> Iterator[slice]:

@@ -28,7 +28,9 @@ import numpy as np
 
 from ..errors import MissingDependencyError, check_choice
 from ..jit import compile_loops
-from ..parse.table import MOTION_RAPID
+from ..parse.table import MOTION_RAPID, DecimalColumn
+
+NO_WORD = int(DecimalColumn.NO_WORD)  # decimal units of no value, as the loops read them
 
 __all__ = ["COMPILED_AFTER_MOVES", "ENGINES", "compiled", "engine", "using"]
 
@@ -215,7 +217,7 @@ def _classic_jerk(dx, dy, dz, de, speed_per_mm, nominal_speed, jx, jy, jz, je, r
     return vmax
 
 
-def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, summing, idx, chained, speed_v, row, by_waypoint,
+def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, scales, summing, idx, chained, speed_v, row, by_waypoint,
                    feed, feed_runs, command, motion, rapid_v, factor, flush, limit_rows,
                    max_velocity, max_accel, square_corner_velocity, minimum_cruise_ratio, initial, z_velocity, z_accel,
                    e_velocity, e_accel, corner_velocity, extrude_only_accel, no_limit_v2):
@@ -226,8 +228,11 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, summing, idx, 
     :class:`.points.MoveEnds` takes them, ``chained`` or not); with
     ``summing``, ``we`` holds each waypoint's extrusion and the extruder
     position is its running sum, added up here in ``np.cumsum``'s order as
-    the waypoints come (they only grow).  ``wz`` and ``feed`` may be stored
-    as runs (:class:`gcodekit.columns.RunColumn`): then ``wz_runs`` and
+    the waypoints come (they only grow).  ``wx``, ``wy`` and ``we`` may be
+    decimal units (:class:`gcodekit.parse.table.DecimalColumn`): then their
+    ``scales`` (``10**places``, three) are not 0, and each unit is read as
+    the column reads it, ``units / scale`` (NaN for ``NO_WORD``).  ``wz`` and
+    ``feed`` may be stored as runs (:class:`gcodekit.columns.RunColumn`): then ``wz_runs`` and
     ``feed_runs`` hold where each run starts and the columns their values
     (empty, the columns are read as they are).  The limits
     in force come from ``limit_rows`` (sorted) and their columns,
@@ -252,6 +257,14 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, summing, idx, 
     j = 0  # limit rows before the move's row
     e_at = -1  # with summing: the waypoint the running sum e_sum has reached
     e_sum = 0.0
+    x_scale, y_scale, e_scale = scales[0], scales[1], scales[2]
+
+    def read(column, scale, k):  # the value at waypoint k, from decimal units when scale is not 0
+        if scale == 0.0:
+            return column[k]
+        units = column[k]
+        return np.nan if units == NO_WORD else units / scale
+
     z_at = feed_at = 0  # with runs: the run of wz and of feed the last move read
     p_kinematic = False
     p_e_r = p_r0 = p_r1 = p_r2 = p_jd = 0.0
@@ -291,15 +304,15 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, summing, idx, 
             if summing:
                 while e_at < v:
                     e_at += 1
-                    e_sum = we[0] if e_at == 0 else e_sum + we[e_at]
+                    e_sum = read(we, e_scale, 0) if e_at == 0 else e_sum + read(we, e_scale, e_at)
                 e_v = e_sum
                 while e_at < w:
                     e_at += 1
-                    e_sum = we[0] if e_at == 0 else e_sum + we[e_at]
+                    e_sum = read(we, e_scale, 0) if e_at == 0 else e_sum + read(we, e_scale, e_at)
                 e_w = e_sum
             else:
-                e_v = we[v] if v >= 0 else 0.0
-                e_w = we[w]
+                e_v = read(we, e_scale, v) if v >= 0 else 0.0
+                e_w = read(we, e_scale, w)
             if wz_runs.size:  # the runs holding v, then w (v < w)
                 z_v = 0.0
                 if v >= 0:
@@ -316,9 +329,11 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, summing, idx, 
             else:
                 z_w, z_v = wz[w], wz[v] if v >= 0 else 0.0
             if v < 0:
-                dx, dy, dz, de = wx[w] - 0.0, wy[w] - 0.0, z_w - 0.0, e_w - 0.0
+                dx, dy, dz, de = read(wx, x_scale, w) - 0.0, read(wy, y_scale, w) - 0.0, z_w - 0.0, e_w - 0.0
             else:
-                dx, dy, dz, de = wx[w] - wx[v], wy[w] - wy[v], z_w - z_v, e_w - e_v
+                dx = read(wx, x_scale, w) - read(wx, x_scale, v)
+                dy = read(wy, y_scale, w) - read(wy, y_scale, v)
+                dz, de = z_w - z_v, e_w - e_v
         else:
             dx = end[i, 0] - start[i, 0]
             dy = end[i, 1] - start[i, 1]

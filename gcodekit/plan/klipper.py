@@ -25,6 +25,7 @@ import numpy as np
 from ..columns import Column, RunColumn
 from ..errors import ConfigError
 from ..memory import release_freed_memory
+from ..parse.table import DecimalColumn
 from .kernels import engine
 from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
 from .points import RunningSum
@@ -36,6 +37,9 @@ if TYPE_CHECKING:
 
 EXTRUDE_ONLY_ACCEL = 99999999.9  # klippy: "self.accel = 99999999.9" for extrude-only moves
 NO_LIMIT_V2 = 999999999.9  # klippy's next_junction_v2 default
+#: Every move is timed by the plan: the emulator's times are read only where nothing moves (see
+#: :func:`gcodekit.plan.times_to_plan`)
+TIMES_EVERY_MOVE = True
 TIE = 1e-9  # relative: squared speeds this close count as equal (see flush)
 
 
@@ -262,13 +266,13 @@ def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict,
     ends = getattr(moves.start, "ends", None)  # a MoveEnds when the points are gathered from the waypoints
     if ends is None:
         points = (np.ascontiguousarray(moves.start, float), np.ascontiguousarray(moves.end, float), False,
-                  *([np.zeros(0)] * 3), NO_RUNS, np.zeros(0), False, np.zeros(0, np.int32), False)
+                  *([np.zeros(0)] * 3), NO_RUNS, np.zeros(0), np.zeros(3), False, np.zeros(0, np.int32), False)
     else:  # the extruder's running sum made as the loop goes, when it is not made already
         x, y, z, e = ends.columns
         summing = isinstance(e, RunningSum)
-        e = e.deltas if summing else e
-        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, np.asarray(x, float), np.asarray(y, float), *_runs(z),
-                  np.asarray(e, float), summing, ends.idx, ends.chained)
+        (x, x_scale), (y, y_scale), (e, e_scale) = (_units(c) for c in (x, y, e.deltas if summing else e))
+        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, x, y, *_runs(z), e, np.array([x_scale, y_scale, e_scale]),
+                  summing, ends.idx, ends.chained)
     if ends is not None and moves.read_from_source:  # each move's speed and row read at its waypoint, in the loop
         src = moves.source
         speeds_and_rows = (np.zeros(0), np.zeros(0, np.int32), True, *_runs(src.feed), src.command,
@@ -295,6 +299,14 @@ def _runs(column: Column) -> tuple[np.ndarray, np.ndarray]:
     if isinstance(column, RunColumn):
         return np.asarray(column.values, float), column.starts.astype(np.int64)
     return np.asarray(column, float), NO_RUNS
+
+
+def _units(column: Column | DecimalColumn) -> tuple[np.ndarray, float]:
+    """A column as the compiled loop reads it: decimal units and their scale (``10**places``), or its values
+    and 0."""
+    if isinstance(column, DecimalColumn):
+        return column.units, 10.0 ** column.places
+    return np.asarray(column, float), 0.0
 
 
 def _move_block(moves, rows, limits, config, flush, lo, hi, m, junction) -> None:

@@ -50,6 +50,9 @@ if TYPE_CHECKING:
 
 COS_REVERSAL = 0.999999  # planner.cpp: a junction_cos_theta above this is a full reversal
 COS_OCTAGON = -0.7071067812  # JD_HANDLE_SMALL_SEGMENTS: junctions sharper than 135 degrees
+#: Every move is timed by the plan: the emulator's times are read only where nothing moves (see
+#: :func:`gcodekit.plan.times_to_plan`)
+TIMES_EVERY_MOVE = True
 AXES = "XYZE"
 
 #: Commands after which Marlin's block buffer drains (planner.synchronize() or a blocking wait).

@@ -385,19 +385,23 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
         no arc is cut into chords).
     """
     w = op.waypoints
-    n = w["x"].size
+    n = len(stored(w, "x"))
     rows = w["command"]
     # Homing moves go to an endstop from wherever the axis really is: their
     # length and time are unknown, and firmware time estimates leave them out.
     homing = in_ids(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
     compiled = engine(n)
-    e = np.cumsum(w["de"]) if compiled is None else None
+    # columns kept compactly (decimal units, runs) are read where needed, or decoded here for a moment: the
+    # operation keeps them compact, and the planner's own arrays come after these
+    points = tuple(stored(w, k) for k in ("x", "y", "z"))
+    e = np.cumsum(stored(w, "de")) if compiled is None else None
     if compiled is not None:  # the same moves and points in one loop, without the temporaries below
-        idx, start, end, is_chained = compiled.move_points(w["x"], w["y"], np.asarray(stored(w, "z")), w["de"],
+        idx, start, end, is_chained = compiled.move_points(*(np.asarray(c) for c in points), np.asarray(stored(w, "de")),
                                                            w["motion"], homing, w["distance"], not gathered)
         idx = _narrow(idx, n)
     else:
-        columns = (w["x"], w["y"], w["z"], e)
+        points = tuple(np.asarray(c) for c in points)
+        columns = (*points, e)
         changed = np.zeros(n, bool)
         for col in columns:  # compare with the previous waypoint column by column
             changed[:1] |= col[:1] != 0
@@ -415,7 +419,7 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     # gathered, the planner reads the speeds and rows a block at a time too: two arrays fewer at its peak
     speed, rows = (None, None) if gathered and not segmenting else (source.speed_v(idx), source.row(idx))
     if gathered or compiled is None:  # the points from the waypoint columns: gathered when asked, else stored
-        ends = MoveEnds((w["x"], w["y"], stored(w, "z"), RunningSum(w["de"], e)), idx, is_chained)
+        ends = MoveEnds((*points, RunningSum(stored(w, "de"), e)), idx, is_chained)
         start, end = (ends.start, ends.end) if gathered and not segmenting else ends.arrays()
         del ends, e
     if not segmenting:

@@ -42,6 +42,9 @@ from .moves import (PlannerMoves, PlanResult, command_rows, firmware_moves, happ
 if TYPE_CHECKING:
     from ..emulate.program import EmulatedProgram
 
+#: Every move is timed by the plan: the emulator's times are read only where nothing moves (see
+#: :func:`gcodekit.plan.times_to_plan`)
+TIMES_EVERY_MOVE = True
 AXES = "XYZE"
 #: Commands RRF runs only once the moves before them are done (LockMovementAndWaitForStandstill).
 REST_NAMES = ("wait_moves", "dwell", "home", "mesh_level", "wait_hotend_temp", "wait_bed_temp",
