@@ -18,7 +18,9 @@ from typing import Union
 
 import numpy as np
 
-__all__ = ["RunColumn", "Waypoints", "Column", "stored", "same_bits", "run_starts"]
+from .growing import GrowingColumn
+
+__all__ = ["RunColumn", "GatheredColumn", "GrowingRuns", "Waypoints", "Column", "stored", "same_bits", "run_starts"]
 
 
 class RunColumn:
@@ -117,6 +119,92 @@ class RunColumn:
         return self.values[np.searchsorted(self.starts, index, side="right") - 1]
 
 
+class GatheredColumn:
+    """A column that repeats another at given places but for a few: ``source[index]``, with ``values`` at
+    ``rows`` (sorted) instead.
+
+    A plan's move lengths are their waypoints' distances but where a move is
+    a chord of an arc or moves the extruder alone: kept so, they cost the
+    exceptions alone.  Indexed like a 1-D array; ``np.asarray`` gives it whole.
+    """
+
+    def __init__(self, source: np.ndarray, index: np.ndarray, rows: np.ndarray, values: np.ndarray):
+        self.source, self.index, self.rows, self.values = source, index, rows, values
+
+    @classmethod
+    def encode(cls, column: np.ndarray, source: np.ndarray, index: np.ndarray, most: float = 1 / 8,
+               block: int = 1 << 16) -> "Column | GatheredColumn":
+        """``column`` as ``source`` at ``index`` (compared bit for bit, a block at a time), or ``column`` itself
+        where more than a fraction ``most`` of it differs."""
+        if not (isinstance(source, np.ndarray) and source.dtype == column.dtype and index.size == column.size):
+            return column
+        rows = []
+        for lo in range(0, column.size, block):
+            differ = np.flatnonzero(bits(column[lo:lo + block]) != bits(source[index[lo:lo + block]]))
+            rows.append(differ + lo)
+            if sum(r.size for r in rows) > most * column.size:
+                return column
+        rows = np.concatenate(rows) if rows else np.zeros(0, np.int64)
+        return cls(source, index, rows, column[rows])
+
+    @property
+    def size(self) -> int:
+        return int(self.index.size)
+
+    @property
+    def shape(self) -> tuple[int]:
+        return (self.size,)
+
+    @property
+    def dtype(self) -> np.dtype:
+        return self.source.dtype
+
+    @property
+    def ndim(self) -> int:
+        return 1
+
+    @property
+    def nbytes(self) -> int:
+        """What it holds of its own (the index and the source are the plan's and the waypoints')."""
+        return int(self.rows.nbytes + self.values.nbytes)
+
+    def __len__(self) -> int:
+        return self.size
+
+    def __repr__(self) -> str:
+        return f"GatheredColumn({self.size} values, {self.rows.size} of their own)"
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        out = self[0:self.size]
+        return out if dtype is None else out.astype(dtype, copy=False)
+
+    def __getitem__(self, index) -> np.ndarray | np.generic:
+        if isinstance(index, slice):
+            lo, hi, step = index.indices(self.size)
+            if step != 1:
+                return np.asarray(self)[index]
+            out = self.source[self.index[lo:hi]]
+            first, last = np.searchsorted(self.rows, (lo, max(hi, lo)))
+            out[self.rows[first:last] - lo] = self.values[first:last]
+            return out
+        if isinstance(index, (int, np.integer)):
+            k = int(index) + (self.size if index < 0 else 0)
+            if not 0 <= k < self.size:
+                raise IndexError(f"index {int(index)} is out of bounds for a column of {self.size}")
+            return self[k:k + 1][0]
+        index = np.asarray(index)
+        if index.dtype == bool:
+            if index.shape != self.shape:
+                raise IndexError(f"a mask of {index.shape} for a column of {self.size}")
+            index = np.flatnonzero(index)
+        index = np.where(index < 0, index + self.size, index)
+        out = self.source[self.index[index]]
+        at = np.minimum(np.searchsorted(self.rows, index), max(self.rows.size - 1, 0))
+        own = (self.rows[at] == index) if self.rows.size else np.zeros(index.shape, bool)
+        out[own] = self.values[at[own]]
+        return out
+
+
 #: What a waypoint column may be stored as (besides decimal units, :class:`gcodekit.parse.table.DecimalColumn`,
 #: which reads as these do).
 Column = Union[np.ndarray, RunColumn]
@@ -139,6 +227,49 @@ def run_starts(values: np.ndarray) -> np.ndarray:
         return np.zeros(min(values.size, 1), np.int64)
     b = bits(values)
     return np.r_[0, np.flatnonzero(b[1:] != b[:-1]) + 1]
+
+
+class GrowingRuns:
+    """A column's runs of bitwise equal values, appended chunk by chunk while there are few of them.
+
+    :meth:`add` refuses a chunk (and takes nothing) once the runs would be
+    too many to be worth keeping: the caller then keeps an array instead.
+    """
+
+    #: Kept as runs while there are at most this many values per run on average (or a few runs in all)
+    MIN_VALUES_PER_RUN = 8
+    FEW_RUNS = 1024
+
+    def __init__(self, dtype: np.dtype):
+        self.dtype = np.dtype(dtype)
+        self.starts = GrowingColumn(np.int64)
+        self.values = GrowingColumn(self.dtype)
+        self.size = 0
+
+    def add(self, col: np.ndarray) -> bool:
+        """Take the chunk's values as runs; False (nothing taken) when the column has too many runs for that,
+        or the chunk's dtype is not the column's."""
+        if col.dtype != self.dtype:
+            return False
+        starts = run_starts(col)
+        n_runs = len(self.values) + starts.size
+        if n_runs > self.FEW_RUNS and n_runs * self.MIN_VALUES_PER_RUN > self.size + col.size:
+            return False
+        if starts.size and len(self.values) and same_bits(self.values.values()[-1], col[0]):
+            starts = starts[1:]  # the chunk goes on with the last run's value
+        self.starts.append(starts + self.size)
+        self.values.append(col[starts])
+        self.size += col.size
+        return True
+
+    def finish(self) -> Column:
+        """The column: a zero-stride view of a lone value, else its runs (start indices as int32 when they fit)."""
+        starts, values = self.starts.finish(), self.values.finish()
+        if values.size == 1:
+            return np.broadcast_to(values[0], (self.size,))
+        if self.size < 2**31:
+            starts = starts.astype(np.int32)
+        return RunColumn(starts, values, self.size)
 
 
 class Waypoints(MutableMapping):

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import gcodekit
-from gcodekit.columns import RunColumn, Waypoints, run_starts, stored
+from gcodekit.columns import GatheredColumn, RunColumn, Waypoints, run_starts, stored
 
 run_values = st.sampled_from([0.0, -0.0, 1.5, np.nan, 2.0, -7.25])
 runs = st.lists(st.tuples(run_values, st.integers(1, 6)), min_size=1, max_size=12)
@@ -89,3 +89,37 @@ def test_an_operation_keeps_its_columns_in_waypoints():
     assert isinstance(op.waypoints, Waypoints)
     op.waypoints = {"x": np.zeros(2)}
     assert isinstance(op.waypoints, Waypoints) and op.waypoints["x"].tolist() == [0.0, 0.0]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(run_values, st.booleans()), min_size=1, max_size=30), st.data())
+def test_a_gathered_column_reads_as_the_values_it_was_made_from(pairs, data):
+    """``source[index]`` but at its own rows: the column it encodes, bit for bit, however read."""
+    source = np.array([v for v, _ in pairs] + [3.0, -0.0])
+    index = np.array(data.draw(st.lists(st.integers(0, source.size - 1), min_size=1, max_size=40)))
+    column = source[index].copy()
+    own = np.resize(np.array([flag for _, flag in pairs]), index.size)
+    column[own] = 9.5  # moves that are not their waypoints' distance
+    got = GatheredColumn.encode(column, source, index, most=1.0)
+    assert isinstance(got, GatheredColumn) and got.rows.size == int(np.count_nonzero(
+        np.ascontiguousarray(column).view(np.uint64) != np.ascontiguousarray(source[index]).view(np.uint64)))
+    n = column.size
+    _same(np.asarray(got), column)
+    lo, hi = data.draw(st.integers(-n - 1, n + 1)), data.draw(st.integers(-n - 1, n + 1))
+    _same(got[lo:hi], column[lo:hi])
+    _same(got[::3], column[::3])
+    k = data.draw(st.integers(-n, n - 1))
+    _same(got[k], column[k])
+    picks = np.array(data.draw(st.lists(st.integers(-n, n - 1), max_size=10)), np.int64)
+    _same(got[picks], column[picks])
+    mask = np.arange(n) % 2 == 0
+    _same(got[mask], column[mask])
+
+
+def test_a_column_mostly_its_own_is_kept_as_it_is():
+    source, index = np.arange(10.0), np.arange(10)
+    column = source + 1.0
+    assert GatheredColumn.encode(column, source, index) is column  # every value its own: no gain
+    assert GatheredColumn.encode(column, source.astype(np.float32), index) is column  # another dtype
+    with pytest.raises(IndexError):
+        GatheredColumn.encode(source.copy(), source, index)[10]

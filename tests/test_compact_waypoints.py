@@ -2,8 +2,9 @@
 same columns and the same plans, bit for bit, as the plain arrays the pipeline kept before.
 
 The reference is the same program read with the compaction turned off
-(every column a float array, the emulator's times kept while planning):
-the path every golden, Klipper and PrusaSlicer comparison checks.
+(every column a float array, the emulator's times kept while planning)
+and planned by the NumPy code: the path every golden, Klipper and
+PrusaSlicer comparison checks.
 """
 
 from __future__ import annotations
@@ -12,10 +13,12 @@ import numpy as np
 import pytest
 
 import gcodekit
+from gcodekit import columns
 from gcodekit.columns import RunColumn, Waypoints
 from gcodekit.parse.table import DecimalColumn
 from gcodekit.pipeline import assemble
 from gcodekit.plan import kernels
+from gcodekit.plan.times import PlannedTimes
 
 ENGINES = ["numpy"] + (["numba"] if kernels.compiled() is not None else [])
 FIELDS = ("start_v", "cruise_v", "end_v", "accel", "accel_t", "cruise_t", "decel_t")
@@ -48,16 +51,16 @@ def program() -> str:
     return _print()
 
 
-def _plain(monkeypatch, text: str, machine: str, engine: str):
-    """The program read with every compaction off."""
+def _plain(monkeypatch, text: str, machine: str):
+    """The program read with every compaction off, planned by the NumPy code (the compiled loops' reference)."""
     with monkeypatch.context() as m:
         m.setattr(assemble, "WRITTEN", ())
-        m.setattr(assemble._Runs, "FEW_RUNS", 0)
-        m.setattr(assemble._Runs, "MIN_VALUES_PER_RUN", 1 << 40)
+        m.setattr(columns.GrowingRuns, "FEW_RUNS", 0)
+        m.setattr(columns.GrowingRuns, "MIN_VALUES_PER_RUN", 1 << 40)
         m.setattr(gcodekit.pipeline, "times_every_move", lambda name: False)
-        with kernels.using(engine):
+        with kernels.using("numpy"):
             op = gcodekit.gcode_to_operation(text, machine)
-    assert all(type(op.waypoints.stored(k)) is np.ndarray for k in op.waypoints)
+    assert all(type(op.waypoints.stored(k)) is np.ndarray for k in op.waypoints if k != "time")  # (times: planned)
     return op
 
 
@@ -70,7 +73,7 @@ def _bits(a) -> np.ndarray:
 def test_compact_waypoints_plan_as_the_plain_ones(program, monkeypatch, machine, engine):
     with kernels.using(engine):
         op = gcodekit.gcode_to_operation(program, machine)
-    plain = _plain(monkeypatch, program, machine, engine)
+    plain = _plain(monkeypatch, program, machine)
     w = op.waypoints
     assert isinstance(w, Waypoints)
     # what the planner reads, still compact after planning: nothing decoded the whole column
@@ -78,6 +81,7 @@ def test_compact_waypoints_plan_as_the_plain_ones(program, monkeypatch, machine,
     assert isinstance(w.stored("de"), DecimalColumn) and w.stored("de").places == 5
     assert isinstance(w.stored("feed"), RunColumn) and isinstance(w.stored("z"), RunColumn)
     assert w.stored("feed").nbytes < np.asarray(plain.waypoints["feed"]).nbytes / 5
+    assert isinstance(w.stored("time"), PlannedTimes)  # computed when read
     moves, result = op.plan
     ref_moves, ref_result = plain.plan
     for field in ("speed_v", "row", "waypoint", "length_d"):

@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import gcodekit
+from gcodekit import columns
 from gcodekit.plan import kernels, marlin, planner_settings, run_planner, scans
 from gcodekit.plan import moves as moves_module
 from shared_corpus import CORPUS as SHARED_CORPUS
@@ -199,13 +200,62 @@ def test_klipper_cruise_agrees(rows):
     m = {"delta_v2": delta_v2, "mcr_delta_v2": mcr_delta_v2}
     ref = klipper._cruise(start_v2, mcr_start_v2, m, max_cruise_v2, flush)
     into = max_cruise_v2.copy()  # the planner's call: the speeds written over their caps
+    none, no_runs = np.zeros(0), np.zeros(0, np.int64)
+    stored = (none, none, no_runs, none, no_runs)  # the increments as given, not made
     got = kernels.compiled().klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, into, flush,
-                                            klipper.TIE, into)
+                                            klipper.TIE, into, *stored)
     assert got is into
     assert_bits_equal(ref, got, "cruise_v2")
     apart = kernels.compiled().klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush,
-                                              klipper.TIE, np.empty(len(rows)))
+                                              klipper.TIE, np.empty(len(rows)), *stored)
     assert_bits_equal(ref, apart, "cruise_v2 into a new array")
+
+
+lengths = st.sampled_from([0.0, 1e-9, 0.3, 2.5, 40.0])
+accels = st.sampled_from([500.0, 1000.0, 3000.0, 99999999.9, 1234.5678])
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(speeds_v2, lengths, accels, accels, st.booleans()), min_size=1, max_size=40),
+       st.sampled_from(["array", "runs", "one"]), st.booleans(), st.booleans(), st.sampled_from([1, 3, 4096]))
+def test_increments_made_where_read_are_the_stored_ones(moves, kept_as, pseudo, cut, block):
+    """The compiled scans and Klipper's cruise loop make ``2 * move_d * accel`` (the least of it and the
+    pseudo acceleration's, where there is one; the cap where ``free``) as they read it: the same speeds, bit
+    for bit, as the NumPy scans given the increments stored."""
+    from gcodekit.plan import klipper
+
+    cap, move_d, accel, pseudo_accel, free = (np.array(c) for c in zip(*moves))
+    if kept_as == "one":
+        accel = np.full(accel.size, accel[0])
+    kept = {"array": accel, "runs": columns.RunColumn.encode(accel, 1),
+            "one": np.broadcast_to(accel[0], accel.shape)}[kept_as]
+    made = scans.Increments(move_d, kept, columns.RunColumn.encode(pseudo_accel, 1) if pseudo else None,
+                            free if cut else None)
+    old = scans.BLOCK
+    scans.BLOCK = block
+    try:
+        out = {}
+        for engine in ("numpy", "numba"):
+            with kernels.using(engine):
+                out[engine] = (scans.forward_min(cap.copy(), made, 1.0), scans.backward_min(cap.copy(), made, 0.5))
+        stored = made.array(cap, forward=True), made.array(cap, forward=False)
+        with kernels.using("numpy"):
+            ref = scans.forward_min(cap, stored[0], 1.0), scans.backward_min(cap, stored[1], 0.5)
+    finally:
+        scans.BLOCK = old
+    for engine in out:
+        assert_bits_equal(ref[0], out[engine][0], f"forward_min, {engine}")
+        assert_bits_equal(ref[1], out[engine][1], f"backward_min, {engine}")
+    if pseudo and not cut:  # Klipper's cruise loop: delta_v2 and mcr_delta_v2 made as it goes
+        delta = scans.Increments(move_d, kept).at(slice(None))
+        flush = np.r_[True, free[1:]]
+        start_v2, mcr_start_v2 = np.sort(cap)[::-1].copy(), np.sort(cap).copy()
+        ref = klipper._cruise(start_v2, mcr_start_v2, {"delta_v2": delta, "mcr_delta_v2": made.at(slice(None))},
+                              cap.copy(), flush)
+        got = kernels.compiled().klipper_cruise(start_v2, mcr_start_v2, np.zeros(0), np.zeros(0), cap.copy(), flush,
+                                                klipper.TIE, np.empty(cap.size), *made.kernel_args()[:5])
+        assert_bits_equal(ref, got, "cruise_v2, increments made")
 
 
 def test_move_points_agree():
@@ -282,6 +332,11 @@ def test_klippers_compiled_set_up_reads_gathered_points_as_stored_ones(text, mac
     (stored, stored_junction), *others = out
     for got, got_junction in others:
         for key in stored:
+            if isinstance(stored[key], scans.Increments):  # made where read: what they are made from
+                for part in ("move_d", "accel", "pseudo_accel"):
+                    assert_bits_equal(*(np.asarray(getattr(m[key], part) if getattr(m[key], part) is not None
+                                                   else np.zeros(0)) for m in (stored, got)), f"{key}.{part}")
+                continue
             assert_bits_equal(stored[key], got[key], key)
         assert_bits_equal(stored_junction, got_junction, "junction")
 

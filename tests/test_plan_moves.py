@@ -11,6 +11,7 @@ import gcodekit
 from gcodekit import plan
 from gcodekit.plan.lookahead import lookahead
 from gcodekit.plan.moves import PlannedMoves, PlannerMoves, PlanResult, happens_before
+from gcodekit.plan.times import PlannedTimes
 
 
 def _moves(rows: list[int]) -> PlannerMoves:
@@ -45,18 +46,14 @@ def test_commands_between_moves_as_counted_by_hand(move_rows, command_rows, in_o
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.lists(st.integers(0, 3), max_size=60), st.integers(1, 7), st.booleans(), st.integers(0, 2**32 - 1))
-def test_waypoint_times_summed_a_block_at_a_time_are_one_bincount(gaps, size, in_order, seed):
-    """Blocks cut only between waypoints give each waypoint the sum np.bincount gives, to the last bit."""
+@given(st.lists(st.integers(0, 3), max_size=60), st.integers(0, 70), st.integers(0, 70), st.booleans(),
+       st.integers(0, 2**32 - 1))
+def test_waypoint_times_read_by_windows_are_one_bincount(gaps, lo, hi, in_order, seed):
+    """Each waypoint's time is the sum np.bincount gives, to the last bit, whichever window it is read in."""
     waypoint = np.cumsum(gaps).astype(np.int32)  # runs of moves per waypoint (an arc's chords), waypoints skipped
     if not in_order:
         np.random.default_rng(seed).shuffle(waypoint)
     durations = np.random.default_rng(seed).random(waypoint.size) * 10.0 ** np.arange(waypoint.size) % 7
-    blocks = list(plan._whole_waypoints(waypoint, size))
-    assert [b.start for b in blocks[1:]] == [b.stop for b in blocks[:-1]]
-    assert sum(b.stop - b.start for b in blocks) == waypoint.size
-    for b in blocks[:-1] if in_order else []:  # no waypoint's moves split between two blocks
-        assert waypoint[b.stop - 1] != waypoint[b.stop]
     n = int(waypoint.max()) + 3 if waypoint.size else 2
     w = {"x": np.zeros(n), "motion": np.full(n, 2, np.uint8), "time": np.zeros(n), "feed": np.ones(n),
          "distance": np.ones(n)}
@@ -64,7 +61,11 @@ def test_waypoint_times_summed_a_block_at_a_time_are_one_bincount(gaps, size, in
                         np.zeros(waypoint.size))
     moves = PlannedMoves(np.ones(waypoint.size), waypoint, waypoint, np.ones(waypoint.size))
     expected = np.bincount(waypoint, weights=durations, minlength=n)
+    times = PlannedTimes(w, moves, result)
     np.testing.assert_array_equal(plan.waypoint_times(w, moves, result).view(np.int64), expected.view(np.int64))
+    np.testing.assert_array_equal(times[lo:hi].view(np.int64), expected[lo:hi].view(np.int64))
+    assert len(times) == n and times[n - 1] == expected[n - 1] and times[-n] == expected[0]
+    np.testing.assert_array_equal(times[::2], expected[::2])
 
 
 v2 = st.one_of(st.floats(0.0, 1e4), st.sampled_from([0.0, 0.0025, 1.0]))  # finite, as planners cap

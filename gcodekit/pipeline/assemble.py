@@ -9,7 +9,7 @@ import numpy as np
 from ..emulate.machine import Machine
 from ..emulate.presets import MachineConfig
 from ..errors import Diagnostics, GcodeError
-from ..columns import Column, RunColumn, Waypoints, run_starts, same_bits
+from ..columns import Column, GrowingRuns, Waypoints, stored
 from ..growing import GrowingColumn
 from ..limits import PLAUSIBLE_TIME_S, Limits
 from ..model.operation import Operation
@@ -71,7 +71,7 @@ class WaypointJoiner:
         self._rows = 0  # command rows of the chunks joined so far
         self._size = 0  # their waypoints
         self._columns: dict[str, GrowingColumn] = {}
-        self._runs: dict[str, _Runs] = {}  # the columns kept as runs so far
+        self._runs: dict[str, GrowingRuns] = {}  # the columns kept as runs so far
 
     def add(self, part: dict[str, np.ndarray], rows: int) -> None:
         """The next chunk's columns (its ``command`` counting from 0) and its number of command rows."""
@@ -81,7 +81,7 @@ class WaypointJoiner:
         if self._first is not None:  # a second chunk: from now on, joined
             (first, first_rows), self._first = self._first, None
             self._keys = list(first)
-            self._runs = {k: _Runs(first[k].dtype) for k in self._keys if k != "command"}
+            self._runs = {k: GrowingRuns(first[k].dtype) for k in self._keys if k != "command"}
             self._take(first, first_rows)
         self._take(part, rows)
 
@@ -119,45 +119,6 @@ class WaypointJoiner:
         return Waypoints(out)
 
 
-class _Runs:
-    """A column's runs of bitwise equal values, chunk by chunk, while there are few of them."""
-
-    #: Kept as runs while there are at most this many values per run on average (or a few runs in all)
-    MIN_VALUES_PER_RUN = 8
-    FEW_RUNS = 1024
-
-    def __init__(self, dtype: np.dtype):
-        self.dtype = np.dtype(dtype)
-        self.starts = GrowingColumn(np.int64)
-        self.values = GrowingColumn(self.dtype)
-        self.size = 0
-
-    def add(self, col: np.ndarray) -> bool:
-        """Take the chunk's values as runs; False (nothing taken) when the column has too many runs for that,
-        or the chunk's dtype is not the column's."""
-        if col.dtype != self.dtype:
-            return False
-        starts = run_starts(col)
-        n_runs = len(self.values) + starts.size
-        if n_runs > self.FEW_RUNS and n_runs * self.MIN_VALUES_PER_RUN > self.size + col.size:
-            return False
-        if starts.size and len(self.values) and same_bits(self.values.values()[-1], col[0]):
-            starts = starts[1:]  # the chunk goes on with the last run's value
-        self.starts.append(starts + self.size)
-        self.values.append(col[starts])
-        self.size += col.size
-        return True
-
-    def finish(self) -> Column:
-        """The column: a zero-stride view of a lone value, else its runs (start indices as int32 when they fit)."""
-        starts, values = self.starts.finish(), self.values.finish()
-        if values.size == 1:
-            return np.broadcast_to(values[0], (self.size,))
-        if self.size < 2**31:
-            starts = starts.astype(np.int32)
-        return RunColumn(starts, values, self.size)
-
-
 def raise_first_run(op: Operation, program: Program, reading_error: GcodeError | None) -> None:
     """Strict mode: raise the error of the line that ran first, as rs274 stops there.
 
@@ -188,14 +149,17 @@ def raise_first_run(op: Operation, program: Program, reading_error: GcodeError |
 def warn_implausible_time(op: Operation) -> None:
     """A warning, at its longest step, when the program would run longer than
     :data:`~gcodekit.limits.PLAUSIBLE_TIME_S` (a year): a runaway arc, dwell or feed, not a real job."""
-    time = np.asarray(op.waypoints["time"], float)
-    finite = np.isfinite(time)  # summed without a copy of the column: NaN counts as 0, inf as the largest float
-    total = float(np.sum(time, where=finite)) + (0.0 if finite.all() else float(np.nan_to_num(time[~finite]).sum()))
+    time = stored(op.waypoints, "time")  # a block at a time: planned times stay computed when read
+    total, longest, most = 0.0, 0, -np.inf
+    for lo in range(0, len(time), 1 << 16):
+        block = np.nan_to_num(np.asarray(time[lo:lo + (1 << 16)], float))  # NaN as 0, inf as the largest float
+        total += float(block.sum())
+        k = int(np.argmax(block)) if block.size else 0
+        if block.size and block[k] > most:
+            longest, most = lo + k, float(block[k])
     if not total > PLAUSIBLE_TIME_S:
         return
-    time = np.nan_to_num(time)
-    longest = int(np.argmax(time))
     row = int(op.waypoints["command"][longest])
     years = total / (365.25 * 86400.0)
     op.diagnostics.warn(int(op.table.line[row]), 1, f"the program would run for {years:,.1f} years (more than a "
-                        f"year, no real job); this step alone takes {time[longest] / 86400.0:,.1f} days")
+                        f"year, no real job); this step alone takes {most / 86400.0:,.1f} days")

@@ -83,10 +83,43 @@ def using(name: str) -> Iterator[None]:
         _chosen.reset(token)
 
 
-def _forward_min(cap, inc, first, block, out):
+def _forward_min(cap, inc, first, block, out, move_d, accel, accel_runs, pseudo, pseudo_runs, free):
     """:func:`.scans.forward_min` (see it for the rule), block by block with its very roundings, into
-    ``out`` (which may be ``cap``: ``cap[k]`` is last read before ``out[k]`` is written)."""
+    ``out`` (which may be ``cap``: ``cap[k]`` is last read before ``out[k]`` is written).
+
+    The increments are ``inc``, or, ``inc`` empty, made where read as
+    :class:`.scans.Increments` makes them: ``2 * move_d * accel`` (the
+    least of that and ``2 * move_d * pseudo`` when ``pseudo`` is given;
+    ``accel`` and ``pseudo`` may be runs: then ``*_runs`` hold where each
+    starts), and where ``free`` the next move's cap (read before it is
+    written over).
+    """
     n = cap.size
+
+    def value_at(values, runs, k, at):  # the value of waypoint k, and the run it is in (runs walked from `at`)
+        if runs.size == 0:
+            return values[k], at
+        while at > 0 and runs[at] > k:
+            at -= 1
+        while at + 1 < runs.size and runs[at + 1] <= k:
+            at += 1
+        return values[at], at
+
+    def increment(k, a_at, p_at):
+        if inc.size:
+            return inc[k], a_at, p_at
+        if free.size and free[k] and k + 1 < n:
+            return cap[k + 1], a_at, p_at
+        a, a_at = value_at(accel, accel_runs, k, a_at)
+        d = (2.0 * move_d[k]) * a
+        if pseudo.size:
+            pa, p_at = value_at(pseudo, pseudo_runs, k, p_at)
+            m = (2.0 * move_d[k]) * pa
+            if m < d or m != m:
+                d = m
+        return d, a_at, p_at
+
+    a_at = p_at = 0
     carry = first
     for start in range(0, n, block):
         stop = min(start + block, n)
@@ -103,8 +136,9 @@ def _forward_min(cap, inc, first, block, out):
                 acc = bound
                 reach = carry
             else:
-                s = inc[start] if k == start + 1 else s + inc[k - 1]
-                reach = (acc + s_prev) + inc[k - 1]
+                d, a_at, p_at = increment(k - 1, a_at, p_at)
+                s = d if k == start + 1 else s + d
+                reach = (acc + s_prev) + d
                 bound = cap[k] - s
                 if not (acc < bound or acc != acc):
                     acc = bound
@@ -117,14 +151,42 @@ def _forward_min(cap, inc, first, block, out):
                 out[k] = base + s
             else:
                 out[k] = carry + s
-        carry = out[stop - 1] + inc[stop - 1]
+        d, a_at, p_at = increment(stop - 1, a_at, p_at)
+        carry = out[stop - 1] + d
     return out
 
 
-def _backward_min(cap, inc, last, block, out):
+def _backward_min(cap, inc, last, block, out, move_d, accel, accel_runs, pseudo, pseudo_runs, free):
     """:func:`.scans.backward_min` (see it for the rule), block by block with its very roundings, into
-    ``out`` (which may be ``cap``, as in :func:`_forward_min`)."""
+    ``out`` (which may be ``cap``, as in :func:`_forward_min`); the increments as there, but where ``free``
+    the move's own cap."""
+
+    def value_at(values, runs, k, at):
+        if runs.size == 0:
+            return values[k], at
+        while at > 0 and runs[at] > k:
+            at -= 1
+        while at + 1 < runs.size and runs[at + 1] <= k:
+            at += 1
+        return values[at], at
+
+    def increment(k, a_at, p_at):
+        if inc.size:
+            return inc[k], a_at, p_at
+        if free.size and free[k]:
+            return cap[k], a_at, p_at
+        a, a_at = value_at(accel, accel_runs, k, a_at)
+        d = (2.0 * move_d[k]) * a
+        if pseudo.size:
+            pa, p_at = value_at(pseudo, pseudo_runs, k, p_at)
+            m = (2.0 * move_d[k]) * pa
+            if m < d or m != m:
+                d = m
+        return d, a_at, p_at
+
     n = cap.size
+    a_at = max(accel_runs.size - 1, 0)
+    p_at = max(pseudo_runs.size - 1, 0)
     carry = last
     for stop in range(n, 0, -block):
         start = max(stop - block, 0)
@@ -134,17 +196,18 @@ def _backward_min(cap, inc, last, block, out):
         base = 0.0
         seed = 0.0
         for k in range(stop - 1, start - 1, -1):
+            d, a_at, p_at = increment(k, a_at, p_at)
             if k == stop - 1:
-                s = inc[k]
+                s = d
                 bound = cap[k] - s
                 if carry < bound:  # Python's min(bound, carry)
                     bound = carry
                 acc = bound
-                reach = carry + inc[k]
-                seed = (carry + inc[k]) - s
+                reach = carry + d
+                seed = (carry + d) - s
             else:
-                reach = (acc + s) + inc[k]
-                s = s + inc[k]
+                reach = (acc + s) + d
+                s = s + d
                 bound = cap[k] - s
                 if not (acc < bound or acc != acc):
                     acc = bound
@@ -242,14 +305,14 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, scales, summin
     or, ``by_waypoint`` (gathered moves), read at its waypoint as
     :class:`.moves.MoveSource` reads them: ``feed`` over 60 (``rapid_v`` for
     a G0 unless NaN), times ``factor`` (unless empty), and ``command``.
-    Returns move_d, accel, max_cruise_v2, delta_v2, mcr_delta_v2, cap and junction.
+    Returns move_d, accel, max_cruise_v2, cap and junction (the increments
+    ``delta_v2`` and ``mcr_delta_v2`` follow from move_d, accel and the
+    limits in force: :class:`.scans.Increments` makes them).
     """
     n = idx.size if by_waypoint else speed_v.size
     move_d_out = np.empty(n)
     accel_out = np.empty(n)
     max_cruise_v2_out = np.empty(n)
-    delta_v2_out = np.empty(n)
-    mcr_delta_v2_out = np.empty(n)
     cap_out = np.empty(n)
     junction = np.empty(n, np.bool_)
     inf = np.inf
@@ -267,7 +330,7 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, scales, summin
 
     z_at = feed_at = 0  # with runs: the run of wz and of feed the last move read
     p_kinematic = False
-    p_e_r = p_r0 = p_r1 = p_r2 = p_jd = 0.0
+    p_e_r = p_r0 = p_r1 = p_r2 = p_jd = p_delta_v2 = 0.0
     for i in range(n):
         if by_waypoint:
             w = idx[i]
@@ -297,7 +360,6 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, scales, summin
         else:
             max_v, max_a, scv, mcr = initial[0], initial[1], initial[2], initial[3]
         jd = scv * scv * sqrt2_minus_1 / max_a
-        mcr_pseudo_accel = max_a * (1.0 - mcr)
         if gathered:
             w = idx[i]
             v = idx[i - 1] if chained and i > 0 else w - 1  # the waypoint the move starts from
@@ -353,7 +415,6 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, scales, summin
             velocity = speed
             accel = extrude_only_accel
         max_cruise_v2 = velocity * velocity
-        mcr_delta_v2 = 2.0 * move_d * mcr_pseudo_accel
         abs_dz = abs(dz)
         z_move = kinematic and abs_dz > 0
         z_ratio = move_d / abs_dz if z_move else inf
@@ -372,8 +433,6 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, scales, summin
         if not (accel < b or accel != accel):
             accel = b
         delta_v2 = 2.0 * move_d * accel
-        if not (mcr_delta_v2 < delta_v2 or mcr_delta_v2 != mcr_delta_v2):
-            mcr_delta_v2 = delta_v2
         joins = False
         cap = 0.0
         if i > 0:
@@ -406,7 +465,7 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, scales, summin
                 b = delta_v2 * quarter_tan_theta_d2
                 if not (corner < b or corner != corner):
                     corner = b
-                b = delta_v2_out[i - 1] * quarter_tan_theta_d2
+                b = p_delta_v2 * quarter_tan_theta_d2
                 if not (corner < b or corner != corner):
                     corner = b
                 if not (cap < corner or cap != cap):
@@ -417,15 +476,19 @@ def _klipper_moves(start, end, gathered, wx, wy, wz, wz_runs, we, scales, summin
         move_d_out[i] = move_d
         accel_out[i] = accel
         max_cruise_v2_out[i] = max_cruise_v2
-        delta_v2_out[i] = delta_v2
-        mcr_delta_v2_out[i] = mcr_delta_v2
-        p_kinematic, p_e_r, p_r0, p_r1, p_r2, p_jd = kinematic, e_r, r0, r1, r2, jd
-    return move_d_out, accel_out, max_cruise_v2_out, delta_v2_out, mcr_delta_v2_out, cap_out, junction
+        p_kinematic, p_e_r, p_r0, p_r1, p_r2, p_jd, p_delta_v2 = kinematic, e_r, r0, r1, r2, jd, delta_v2
+    return move_d_out, accel_out, max_cruise_v2_out, cap_out, junction
 
 
-def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush, tie_r, cruise_v2):
+def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v2, flush, tie_r, cruise_v2,
+                    move_d, move_accel, accel_runs, pseudo, pseudo_runs):
     """:func:`.klipper._cruise`: each move's cruise speed squared, into ``cruise_v2`` (which may be
     ``max_cruise_v2``: each cap is read before its move's speed is written).
+
+    The increments are ``delta_v2`` and ``mcr_delta_v2``, or, those empty,
+    made where read from ``move_d``, ``move_accel`` and ``pseudo`` (the minimum
+    cruise ratio's pseudo acceleration) as :class:`.scans.Increments` makes
+    them (``*_runs``: where each run starts, for columns kept as runs).
 
     A backward pass finds, for each move, the nearest move at or after it in
     the same flush that sets a peak (``next_marked``); a forward pass keeps
@@ -433,25 +496,46 @@ def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v
     whose minimum is the earliest of equal values, as here).
     """
     n = start_v2.size
+
+    def value_at(values, runs, k, at):  # the value of move k, and the run it is in (runs walked from `at`)
+        if runs.size == 0:
+            return values[k], at
+        while at > 0 and runs[at] > k:
+            at -= 1
+        while at + 1 < runs.size and runs[at + 1] <= k:
+            at += 1
+        return values[at], at
+
+    a_at = max(accel_runs.size - 1, 0)
+    p_at = max(pseudo_runs.size - 1, 0)
     can_accel = np.empty(n, np.bool_)
     has_next = False  # a peak-setting move at or after i in i's flush
     peak = 0.0
     for i in range(n - 1, -1, -1):
+        if delta_v2.size:
+            delta, mcr_delta = delta_v2[i], mcr_delta_v2[i]
+        else:
+            a, a_at = value_at(move_accel, accel_runs, i, a_at)
+            pa, p_at = value_at(pseudo, pseudo_runs, i, p_at)
+            delta = (2.0 * move_d[i]) * a
+            mcr_delta = (2.0 * move_d[i]) * pa
+            if not (mcr_delta < delta or mcr_delta != mcr_delta):
+                mcr_delta = delta
         last_of_segment = i == n - 1 or flush[i + 1]
         if last_of_segment:
             next_start = next_mcr = 0.0
             has_next = False  # the next flush's peaks are not this one's
         else:
             next_start, next_mcr = start_v2[i + 1], mcr_start_v2[i + 1]
-        reach = next_mcr + mcr_delta_v2[i]
+        reach = next_mcr + mcr_delta
         tie = tie_r * (reach if (reach > 1.0 or reach != reach) else 1.0)
         accel = mcr_start_v2[i] < reach - tie
         can_accel[i] = accel
         pending = not last_of_segment and not can_accel[i + 1]
-        if accel and (mcr_start_v2[i] + mcr_delta_v2[i] > next_mcr + tie or pending):
+        if accel and (mcr_start_v2[i] + mcr_delta > next_mcr + tie or pending):
             has_next = True
             peak = (mcr_start_v2[i] + reach) * 0.5
-        c = ((next_start + delta_v2[i]) + start_v2[i]) * 0.5
+        c = ((next_start + delta) + start_v2[i]) * 0.5
         b = max_cruise_v2[i]
         if not (c < b or c != c):
             c = b

@@ -22,14 +22,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..columns import Column, RunColumn
+from ..columns import Column, GatheredColumn, GrowingRuns, RunColumn, stored
 from ..errors import ConfigError
 from ..memory import release_freed_memory
 from ..parse.table import DecimalColumn
 from .kernels import engine
-from .moves import PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before, in_force, speed_factor
+from .moves import (PlannedMoves, PlannerMoves, PlanResult, StepSetting, command_rows, firmware_moves, happens_before,
+                    in_force, speed_factor)
 from .points import RunningSum
-from .scans import backward_min, forward_min, next_marked, segmented_cummin
+from .scans import Increments, backward_min, forward_min, next_marked, segmented_cummin
 from .trapezoids import NextEntry, TrapezoidPlan
 
 if TYPE_CHECKING:
@@ -248,12 +249,15 @@ def plan(op: "EmulatedProgram", config: KlipperConfig) -> tuple[PlannerMoves | P
     mcr_start_v2 = backward_min(max_mcr_start_v2, m["mcr_delta_v2"], out=max_mcr_start_v2)
     del cap, mcr_cap, max_start_v2, max_mcr_start_v2
     max_cruise_v2 = m.pop("max_cruise_v2")  # the cruise speeds are written over their caps
-    if compiled is not None:
-        cruise_v2 = compiled.klipper_cruise(start_v2, mcr_start_v2, m["delta_v2"], m["mcr_delta_v2"], max_cruise_v2,
-                                            flush, TIE, max_cruise_v2)
+    if compiled is not None:  # the increments made as the loop goes
+        cruise_v2 = compiled.klipper_cruise(start_v2, mcr_start_v2, np.zeros(0), np.zeros(0), max_cruise_v2,
+                                            flush, TIE, max_cruise_v2, *m["mcr_delta_v2"].kernel_args()[:5])
     else:
         cruise_v2 = _cruise(start_v2, mcr_start_v2, m, max_cruise_v2, flush)
     del mcr_start_v2, max_cruise_v2, m["delta_v2"], m["mcr_delta_v2"]  # free before the trapezoids
+    # the lengths kept as the waypoints' distances they repeat (but arcs' chords, extruder-only moves)
+    planned.length_d = m["move_d"] = GatheredColumn.encode(m["move_d"], stored(op.waypoints, "distance"),
+                                                           planned.waypoint)
     release_freed_memory()
     # a move ends at the next one's start, but at rest before a flush and after the last move (not stored)
     next_start_v2 = NextEntry(start_v2, np.flatnonzero(flush[1:]), 0.0)
@@ -287,7 +291,29 @@ def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict,
         np.array([float(getattr(config, k)) for k in names]), float(config.max_z_velocity or config.max_velocity),
         float(config.max_z_accel or config.max_accel), float(config.max_e_velocity), float(config.max_e_accel),
         float(config.instantaneous_corner_velocity), EXTRUDE_ONLY_ACCEL, NO_LIMIT_V2)
-    return dict(zip(("move_d", "accel", "max_cruise_v2", "delta_v2", "mcr_delta_v2", "cap"), out[:6])), out[6]
+    m = dict(zip(("move_d", "accel", "max_cruise_v2", "cap"), out[:4]))
+    # the accelerations as runs (a print's few settings), the increments made where the scans read them
+    m["accel"] = RunColumn.encode(m["accel"])
+    m["delta_v2"] = Increments(m["move_d"], m["accel"])
+    m["mcr_delta_v2"] = Increments(m["move_d"], m["accel"], _pseudo_accel(moves, rows, limits, config))
+    return m, out[4]
+
+
+def _pseudo_accel(moves: PlannerMoves, rows: np.ndarray, limits: dict, config: KlipperConfig) -> Column:
+    """Each move's minimum cruise ratio pseudo acceleration, ``max_accel * (1 - minimum_cruise_ratio)`` in
+    force (as :func:`_move_block` has it), a block of moves at a time: runs, where a print changes its
+    limits a few times."""
+    max_accel = StepSetting(rows, limits["max_accel"], config.max_accel)
+    ratio = StepSetting(rows, limits["minimum_cruise_ratio"], config.minimum_cruise_ratio)
+    n, runs, blocks = len(moves), GrowingRuns(np.float64), []
+    for lo in range(0, n, BLOCK):
+        move_rows = moves.rows(slice(lo, min(lo + BLOCK, n)))
+        values = max_accel.at(move_rows) * (1.0 - ratio.at(move_rows))
+        if runs is not None and not runs.add(values):  # too many changes: an array
+            blocks, runs = [np.asarray(runs.finish())], None
+        if runs is None:
+            blocks.append(values)
+    return runs.finish() if runs is not None else np.concatenate(blocks)
 
 
 NO_RUNS = np.zeros(0, np.int64)  # a column read as it is
@@ -298,6 +324,8 @@ def _runs(column: Column) -> tuple[np.ndarray, np.ndarray]:
     array)."""
     if isinstance(column, RunColumn):
         return np.asarray(column.values, float), column.starts.astype(np.int64)
+    if np.asarray(column).strides == (0,) and len(column):  # one value: one run
+        return np.asarray(column[:1], float).copy(), np.zeros(1, np.int64)
     return np.asarray(column, float), NO_RUNS
 
 

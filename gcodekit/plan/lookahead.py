@@ -8,10 +8,13 @@ trapezoid.  The firmware modules compute their own caps and call these.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
+from .kernels import engine
 from .moves import PlanResult
-from .scans import backward_min, forward_min
+from .scans import Increments, backward_min, forward_min
 from .trapezoids import NextEntry, TrapezoidPlan
 
 __all__ = ["BLOCK", "limit_by_axis_maximum", "lookahead", "trapezoid", "empty_result", "unit_vectors"]
@@ -34,7 +37,7 @@ def limit_by_axis_maximum(max_value, unit_vec) -> np.ndarray:
     return limit
 
 
-def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.ndarray, *,
+def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray | Increments, rest_after: np.ndarray, *,
               rest_v2: float = 0.0, nominal_length: np.ndarray | None = None,
               reuse: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Entry and exit speeds (squared) after the reverse and forward passes.
@@ -44,8 +47,10 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     max_entry_v2 : ndarray
         Cap on each move's entry speed (the junction limit; for the first
         move after a rest, the speed it may start at).
-    delta_v2 : ndarray
-        ``2 * accel * move_d``: what a move can add to (or shed from) v^2.
+    delta_v2 : ndarray or Increments
+        ``2 * accel * move_d``: what a move can add to (or shed from) v^2
+        (:class:`.scans.Increments`: made where the compiled scans read
+        them, an array fewer).
     rest_after : ndarray of bool
         The machine stops after this move (the last one is always a stop).
     rest_v2 : float, default: 0
@@ -82,6 +87,17 @@ def lookahead(max_entry_v2: np.ndarray, delta_v2: np.ndarray, rest_after: np.nda
     if nominal_length is not None:
         free |= nominal_length
     stop = rest_after if nominal_length is None else rest_after & ~nominal_length  # a nominal_length move: its cap
+    if isinstance(delta_v2, Increments) and engine(n) is not None:  # the compiled scans make them as they go
+        bound = max_entry_v2 if reuse and _writable(max_entry_v2) else np.array(max_entry_v2, float)
+        at = np.flatnonzero(stop)
+        bound[at] = np.minimum(bound[at], rest_v2 + delta_v2.at(at))
+        del stop, at, max_entry_v2
+        increments = dataclasses.replace(delta_v2, free=free)
+        reverse_v2 = backward_min(bound, increments, out=bound)
+        entry_v2 = forward_min(reverse_v2, increments, first=float(reverse_v2[0]), out=reverse_v2) if n else reverse_v2
+        return entry_v2, NextEntry(entry_v2, np.flatnonzero(rest_after), rest_v2)
+    if isinstance(delta_v2, Increments):  # the NumPy scans read them stored
+        delta_v2 = delta_v2.at(slice(None))
     if reuse and _writable(max_entry_v2):
         bound = max_entry_v2
         np.minimum(bound, rest_v2 + delta_v2, out=bound, where=stop)

@@ -37,12 +37,14 @@ from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 
+from ..columns import GatheredColumn, stored
 from ..errors import ConfigError
 from ..memory import release_freed_memory
 from .kernels import engine
 from .lookahead import BLOCK, _trapezoid_block, empty_result, limit_by_axis_maximum, lookahead, unit_vectors
 from .moves import (PlannedMoves, PlannerMoves, PlanResult, command_rows, firmware_moves, happens_before,
                     StepSetting, m204_in_force, settings_in_force, speed_factor)
+from .scans import Increments
 from .trapezoids import TrapezoidPlan
 
 if TYPE_CHECKING:
@@ -310,17 +312,24 @@ def plan(op: "EmulatedProgram", config: MarlinConfig) -> tuple[PlannerMoves | Pl
     del moves  # the end points are no longer needed: free them before the passes
     release_freed_memory()
     minimum_planner_speed_sqr = config.minimum_planner_speed**2
-    delta_v2 = 2.0 * acceleration * millimeters
+    delta_v2 = Increments(millimeters, acceleration)  # 2 * acceleration * millimeters, made where read
     nominal_speed_sqr = block.pop("nominal_speed")
     nominal_speed_sqr *= nominal_speed_sqr  # squared in place: one array fewer
     # "If a block can de/ac-celerate from nominal speed to zero within the length of the block, then the
     # current block and next block junction speeds are guaranteed to always be at their maximum"
-    nominal_length = nominal_speed_sqr <= minimum_planner_speed_sqr + delta_v2
+    nominal_length = np.empty(n, bool)
+    for lo in range(0, n, BLOCK):
+        sl = slice(lo, min(lo + BLOCK, n))
+        nominal_length[sl] = nominal_speed_sqr[sl] <= minimum_planner_speed_sqr + delta_v2.at(sl)
     rest_after = np.r_[rest_before[1:], True]
+    del rest_before
     entry_speed_sqr, exit_speed_sqr = lookahead(block.pop("max_entry_speed_sqr"), delta_v2, rest_after,
                                                 rest_v2=minimum_planner_speed_sqr, nominal_length=nominal_length,
                                                 reuse=True)
     del block, delta_v2, nominal_length, rest_after
+    # the lengths kept as the waypoints' distances they repeat (but arcs' chords, extruder-only moves)
+    planned.length_d = millimeters = GatheredColumn.encode(millimeters, stored(op.waypoints, "distance"),
+                                                           planned.waypoint)
     release_freed_memory()  # the passes' temporaries, before the trapezoids' arrays
     # the trapezoids are computed when read (TrapezoidPlan): three arrays fewer kept
     return planned, TrapezoidPlan(_trapezoid_block, millimeters, acceleration, entry_speed_sqr, nominal_speed_sqr,

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from ..columns import Column, stored
+from ..columns import Column, GatheredColumn, stored
 from ..emulate import arcs
 from ..parse.table import MOTION_RAPID, NAME_ID, in_ids
 from .kernels import engine
@@ -165,7 +165,9 @@ class PlannedMoves(_SpeedsAndRows):
     row, waypoint : ndarray of int32 (int64 past 2**31)
         Command row and waypoint each move comes from.
     length_d : ndarray
-        Toolhead travel (mm); the extruder's for extruder-only moves.
+        Toolhead travel (mm); the extruder's for extruder-only moves (kept
+        as a :class:`~gcodekit.columns.GatheredColumn` of the waypoints'
+        distances where a planner gives it so).
 
     Given a ``source`` instead of ``speed_v`` and ``row``, those two are read
     from the waypoint columns at each move's waypoint, on every access.
@@ -176,13 +178,21 @@ class PlannedMoves(_SpeedsAndRows):
         if source is None and (speed_v is None or row is None):
             raise ValueError("planned moves need their speeds and rows, or the source to read them from")
         self._speed_v, self._row, self.source = speed_v, row, source
-        self.waypoint, self.length_d = waypoint, length_d
+        self.waypoint, self._length_d = waypoint, length_d
 
     def __len__(self) -> int:
         return int(self.waypoint.size)
 
     def __repr__(self) -> str:
         return f"PlannedMoves({len(self)} moves)"
+
+    @property
+    def length_d(self) -> np.ndarray:
+        return np.asarray(self._length_d)
+
+    @length_d.setter
+    def length_d(self, lengths: np.ndarray | GatheredColumn) -> None:
+        self._length_d = lengths
 
 
 @dataclass

@@ -27,24 +27,92 @@ their size never costs precision.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from ..columns import Column, RunColumn
 from .kernels import engine
 
 BLOCK = 4096
 
 
-def forward_min(cap: np.ndarray, inc: np.ndarray, first: float = 0.0, *, out: np.ndarray | None = None) -> np.ndarray:
+@dataclass(eq=False)
+class Increments:
+    """A scan's increments, made where the compiled scans read them instead of stored (an array fewer).
+
+    Each move's ``2 * move_d * accel`` (what it adds to or sheds from v^2),
+    or the least of that and ``2 * move_d * pseudo_accel`` (Klipper's
+    minimum cruise ratio) when ``pseudo_accel`` is given; where ``free``,
+    the scan's own cap instead: the move's own, scanning backward, the next
+    move's, scanning forward (a stop cuts the recurrence, see
+    :func:`.lookahead.lookahead`).  ``accel`` and ``pseudo_accel`` may be
+    runs (:class:`~gcodekit.columns.RunColumn`).  Doubling is exact, so
+    ``2 * move_d * accel`` is ``2 * accel * move_d`` to the last bit.
+    """
+
+    move_d: np.ndarray
+    accel: Column
+    pseudo_accel: Column | None = None
+    free: np.ndarray | None = None
+
+    def at(self, moves: np.ndarray) -> np.ndarray:
+        """The increments (``free`` aside) of the moves ``moves``."""
+        delta = 2.0 * np.asarray(self.move_d[moves], float) * np.asarray(self.accel[moves], float)
+        if self.pseudo_accel is not None:
+            least = 2.0 * np.asarray(self.move_d[moves], float) * np.asarray(self.pseudo_accel[moves], float)
+            delta = np.where((least < delta) | (least != least), least, delta)
+        return delta
+
+    def array(self, cap: np.ndarray, forward: bool) -> np.ndarray:
+        """Every increment, as the NumPy scans read them (``cap`` as the scan reads it, before it writes)."""
+        out = self.at(slice(None))
+        if self.free is not None and forward:
+            np.copyto(out[:-1], cap[1:], where=self.free[:-1])
+        elif self.free is not None:
+            np.copyto(out, cap, where=self.free)
+        return out
+
+    def kernel_args(self) -> tuple:
+        """What the compiled scans take after ``out``: move_d, accel and its runs, pseudo_accel and its runs, free."""
+        none, no_runs = np.zeros(0), np.zeros(0, np.int64)
+        args = [np.ascontiguousarray(self.move_d, float)]
+        for column in (self.accel, self.pseudo_accel):
+            if column is None:
+                args += [none, no_runs]
+            elif isinstance(column, RunColumn):
+                args += [np.asarray(column.values, float), column.starts.astype(np.int64)]
+            elif np.ndim(column) == 1 and np.shape(column)[0] and np.asarray(column).strides == (0,):  # one value
+                args += [np.asarray(column[:1], float).copy(), np.zeros(1, np.int64)]
+            else:
+                args += [np.ascontiguousarray(column, float), no_runs]
+        args.append(np.zeros(0, np.bool_) if self.free is None else np.ascontiguousarray(self.free, np.bool_))
+        return tuple(args)
+
+
+def _stored_args() -> tuple:
+    """:meth:`Increments.kernel_args` when the increments are an array."""
+    none, no_runs = np.zeros(0), np.zeros(0, np.int64)
+    return none, none, no_runs, none, no_runs, np.zeros(0, np.bool_)
+
+
+def forward_min(cap: np.ndarray, inc: np.ndarray | Increments, first: float = 0.0, *,
+                out: np.ndarray | None = None) -> np.ndarray:
     """``m[0] = min(cap[0], first)``; ``m[i] = min(cap[i], m[i-1] + inc[i-1])``.
 
     ``out`` (a float64 array of ``cap``'s size, which may be ``cap`` itself:
     each cap is read before its move's value is written) receives ``m``.
+    ``inc`` may be :class:`Increments`, made where read.
     """
     out = _output(out, cap)
     kernels = engine(cap.size)
     if kernels is not None:
-        kernels.forward_min(_floats(cap), _floats(inc), float(first), BLOCK, out)
+        made = isinstance(inc, Increments)
+        kernels.forward_min(_floats(cap), np.zeros(0) if made else _floats(inc), float(first), BLOCK, out,
+                            *(inc.kernel_args() if made else _stored_args()))
         return out
+    if isinstance(inc, Increments):
+        inc = inc.array(cap, forward=True)
     n = cap.size
     carry = first  # what the move before the block allows at the block's first junction
     for start in range(0, n, BLOCK):
@@ -61,16 +129,21 @@ def forward_min(cap: np.ndarray, inc: np.ndarray, first: float = 0.0, *, out: np
     return out
 
 
-def backward_min(cap: np.ndarray, inc: np.ndarray, last: float = 0.0, *, out: np.ndarray | None = None) -> np.ndarray:
+def backward_min(cap: np.ndarray, inc: np.ndarray | Increments, last: float = 0.0, *,
+                 out: np.ndarray | None = None) -> np.ndarray:
     """``s[n-1] = min(cap[n-1], last + inc[n-1])``; ``s[i] = min(cap[i], s[i+1] + inc[i])``.
 
-    ``out`` as in :func:`forward_min` (``cap`` itself allowed).
+    ``out`` as in :func:`forward_min` (``cap`` itself allowed); ``inc`` as there.
     """
     out = _output(out, cap)
     kernels = engine(cap.size)
     if kernels is not None:
-        kernels.backward_min(_floats(cap), _floats(inc), float(last), BLOCK, out)
+        made = isinstance(inc, Increments)
+        kernels.backward_min(_floats(cap), np.zeros(0) if made else _floats(inc), float(last), BLOCK, out,
+                             *(inc.kernel_args() if made else _stored_args()))
         return out
+    if isinstance(inc, Increments):
+        inc = inc.array(cap, forward=False)
     n = cap.size
     carry = last  # s of the move after the block
     for stop in range(n, 0, -BLOCK):

@@ -19,6 +19,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..columns import Column
 from .kernels import engine
 from .moves import PlanResult
 
@@ -114,7 +115,8 @@ class TrapezoidPlan:
     shape : callable
         The planner's block function (see :data:`Shape`).
     move_d, accel : ndarray
-        Each move's length (mm) and acceleration (mm/s^2).
+        Each move's length (mm) and acceleration (mm/s^2); the accelerations
+        may be a :class:`~gcodekit.columns.RunColumn` (read a block at a time).
     *v2 : ndarray or NextEntry
         The three squared speeds ``shape`` takes, mm^2/s^2 (the exits may be
         a :class:`NextEntry`).
@@ -123,16 +125,21 @@ class TrapezoidPlan:
         :func:`.kernels.engine` chooses it for a plan this size.
     """
 
-    def __init__(self, shape: Shape, move_d: np.ndarray, accel: np.ndarray, *v2: np.ndarray,
+    def __init__(self, shape: Shape, move_d: np.ndarray, accel: Column, *v2: np.ndarray,
                  kernel: str | None = None):
-        self._shape, self._move_d, self.accel, self._v2, self._kernel = shape, move_d, accel, v2, kernel
+        self._shape, self._move_d, self._accel, self._v2, self._kernel = shape, move_d, accel, v2, kernel
+
+    @property
+    def accel(self) -> np.ndarray:
+        """Each move's acceleration (mm/s^2), kept as its runs where it has few (a print's few settings)."""
+        return np.asarray(self._accel)
 
     def _compiled(self, sel, fields: tuple[str, ...], duration: bool = False) -> tuple[PlanResult, np.ndarray] | None:
         """The fields (and the durations) by the compiled loop, or None when the NumPy code is to compute them."""
         compiled = engine(len(self)) if self._kernel else None
         if compiled is None:
             return None
-        move_d, accel = self._move_d[sel], self.accel[sel]
+        move_d, accel = self._move_d[sel], self._accel[sel]
         n, none = move_d.size, np.empty(0)
         speeds = [np.empty(n) if any(f in fields for f in FIELDS[:3]) else none for _ in range(3)]
         times = [np.empty(n) if any(f in fields for f in FIELDS[3:]) else none for _ in range(3)]
@@ -152,7 +159,7 @@ class TrapezoidPlan:
         compiled = self._compiled(sel, fields)
         if compiled is not None:
             return compiled[0]
-        move_d, accel = self._move_d[sel], self.accel[sel]
+        move_d, accel = self._move_d[sel], self._accel[sel]
         v2 = [a[sel] for a in self._v2]
         n = move_d.size
         out = PlanResult(**{f: np.empty(n) if f in fields else _Discard() for f in FIELDS}, accel=accel)
