@@ -1,14 +1,17 @@
-"""Waypoint columns kept as their runs of equal values, and the mapping that gives them as arrays.
+"""Columns kept compactly (as runs of equal values, or as another column's values) and the mapping that gives
+them as arrays.
 
 A large print's feed rate, layer height and flow change a few thousand
 times over millions of waypoints.  Stored as their runs (where each run
-starts, and its value), such a column takes a few hundred kilobytes
-instead of 25 MB.  :class:`Waypoints` is the mapping an operation keeps
-its columns in: reading a column gives it as an array, decoded on the
-first read and kept so from then on; :meth:`Waypoints.stored` gives what
-is stored, which a planner reads a block of moves at a time without
-decoding the whole column.  Values come back bit for bit (runs are
-compared by their bits: ``-0.0`` and each NaN are their own values).
+starts, and its value: :class:`RunColumn`), such a column takes a few
+hundred kilobytes instead of 25 MB; a plan's move lengths are mostly their
+waypoints' distances (:class:`GatheredColumn` keeps the exceptions).
+:class:`Waypoints` is the mapping an operation keeps its columns in:
+reading a column gives it as an array, decoded on the first read and kept
+so from then on; :meth:`Waypoints.stored` gives what is stored, which a
+planner reads a block of moves at a time without decoding the whole
+column.  Values come back bit for bit (runs are compared by their bits:
+``-0.0`` and each NaN are their own values).
 """
 
 from __future__ import annotations
@@ -205,9 +208,9 @@ class GatheredColumn:
         return out
 
 
-#: What a waypoint column may be stored as (besides decimal units, :class:`gcodekit.parse.table.DecimalColumn`,
-#: which reads as these do).
-Column = Union[np.ndarray, RunColumn]
+#: What a column may be stored as (besides decimal units, :class:`gcodekit.parse.table.DecimalColumn`, and a
+#: plan's times, :class:`gcodekit.plan.times.PlannedTimes`, which read as these do).
+Column = Union[np.ndarray, RunColumn, GatheredColumn]
 
 
 def bits(values: np.ndarray) -> np.ndarray:

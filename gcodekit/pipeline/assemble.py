@@ -6,10 +6,10 @@ import os
 
 import numpy as np
 
+from ..columns import Column, GrowingRuns, Waypoints, stored
 from ..emulate.machine import Machine
 from ..emulate.presets import MachineConfig
 from ..errors import Diagnostics, GcodeError
-from ..columns import Column, GrowingRuns, Waypoints, stored
 from ..growing import GrowingColumn
 from ..limits import PLAUSIBLE_TIME_S, Limits
 from ..model.operation import Operation
@@ -70,7 +70,7 @@ class WaypointJoiner:
         self._keys: list[str] = []
         self._rows = 0  # command rows of the chunks joined so far
         self._size = 0  # their waypoints
-        self._columns: dict[str, GrowingColumn] = {}
+        self._columns: dict[str, GrowingColumn | GrowingDecimals] = {}
         self._runs: dict[str, GrowingRuns] = {}  # the columns kept as runs so far
 
     def add(self, part: dict[str, np.ndarray], rows: int) -> None:
