@@ -81,7 +81,7 @@ class RunColumn:
 
     def _lengths(self, lo: int, hi: int) -> tuple[int, np.ndarray]:
         """The first run reaching into ``[lo, hi)`` and how many of its values each run from it gives."""
-        first, last = np.searchsorted(self.starts, (lo, hi), side="right") - 1
+        first, last = np.searchsorted(self.starts, np.array((lo, hi), self.starts.dtype), side="right") - 1
         bounds = np.clip(np.r_[self.starts[first + 1:last + 1], hi], lo, hi)
         return int(first), np.diff(np.r_[lo, bounds])
 

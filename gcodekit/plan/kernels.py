@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import MissingDependencyError, check_choice
 from ..jit import compile_loops
+from ..columns import RunColumn
 from ..parse.table import MOTION_RAPID, DecimalColumn
 
 NO_WORD = int(DecimalColumn.NO_WORD)  # decimal units of no value, as the loops read them
@@ -559,7 +560,7 @@ def _klipper_cruise(start_v2, mcr_start_v2, delta_v2, mcr_delta_v2, max_cruise_v
     return cruise_v2
 
 
-def _move_points(x, y, z, de, motion, homing, distance, with_points):
+def _move_points(x, y, z, z_runs, de, scales, motion, homing, distance, with_points):
     """:func:`.moves.firmware_moves`' choice of moves and :class:`.points.MoveEnds`' points, in two passes.
 
     A waypoint is a move when it moves (``motion > 0``), is no homing move,
@@ -567,28 +568,48 @@ def _move_points(x, y, z, de, motion, homing, distance, with_points):
     as ``np.cumsum``) or is a full circle.  Returns the moves' waypoints,
     their start and end points (rows of one array of points when each move
     starts where the one before ended, ``chained``, else two arrays; none
-    without ``with_points``) and ``chained``.
+    without ``with_points``) and ``chained``.  ``x``, ``y`` and ``de`` may
+    be decimal units and ``z`` runs, read as :func:`_klipper_moves` reads
+    them (``scales`` of x, y and de; ``z_runs``).
     """
-    n = x.size
+    n = motion.size
+
+    def read(column, scale, k):  # the value at waypoint k, from decimal units when scale is not 0
+        if scale == 0.0:
+            return column[k]
+        units = column[k]
+        return np.nan if units == NO_WORD else units / scale
+
+    def z_at(k, at):  # z at waypoint k, and its run (the waypoints come in order)
+        if z_runs.size == 0:
+            return z[k], at
+        while at + 1 < z_runs.size and z_runs[at + 1] <= k:
+            at += 1
+        return z[at], at
+
+    x_scale, y_scale, e_scale = scales[0], scales[1], scales[2]
     is_move = np.zeros(n, np.bool_)
     count = 0
     chained = True
     e = 0.0
     px = py = pz = pe = 0.0  # the waypoint before
     lx = ly = lz = le = 0.0  # the last move's end
+    at = 0
     for i in range(n):
-        e = de[i] if i == 0 else e + de[i]
+        e = read(de, e_scale, i) if i == 0 else e + read(de, e_scale, i)
+        xi, yi = read(x, x_scale, i), read(y, y_scale, i)
+        zi, at = z_at(i, at)
         if i == 0:
-            changed = x[i] != 0 or y[i] != 0 or z[i] != 0 or e != 0
+            changed = xi != 0 or yi != 0 or zi != 0 or e != 0
         else:
-            changed = x[i] != px or y[i] != py or z[i] != pz or e != pe
+            changed = xi != px or yi != py or zi != pz or e != pe
         if motion[i] > 0 and not homing[i] and (changed or (motion[i] >= 3 and distance[i] > 0)):
             if count > 0 and not (px == lx and py == ly and pz == lz and pe == le):
                 chained = False  # this move does not start where the last one ended
             is_move[i] = True
             count += 1
-            lx, ly, lz, le = x[i], y[i], z[i], e
-        px, py, pz, pe = x[i], y[i], z[i], e
+            lx, ly, lz, le = xi, yi, zi, e
+        px, py, pz, pe = xi, yi, zi, e
     idx = np.empty(count, np.int64)
     m = count if with_points else 0
     start = np.empty((m + 1 if chained else m, 4))
@@ -596,8 +617,14 @@ def _move_points(x, y, z, de, motion, homing, distance, with_points):
     k = 0
     e = 0.0
     px = py = pz = pe = 0.0
+    at = 0
     for i in range(n):
-        e = de[i] if i == 0 else e + de[i]
+        e = read(de, e_scale, i) if i == 0 else e + read(de, e_scale, i)
+        if with_points:
+            xi, yi = read(x, x_scale, i), read(y, y_scale, i)
+            zi, at = z_at(i, at)
+        else:  # the moves' waypoints alone
+            xi = yi = zi = 0.0
         if is_move[i]:
             idx[k] = i
             if with_points:
@@ -606,10 +633,31 @@ def _move_points(x, y, z, de, motion, homing, distance, with_points):
                         start[k, 0] = start[k, 1] = start[k, 2] = start[k, 3] = 0.0
                     else:
                         start[k, 0], start[k, 1], start[k, 2], start[k, 3] = px, py, pz, pe
-                end[k, 0], end[k, 1], end[k, 2], end[k, 3] = x[i], y[i], z[i], e
+                end[k, 0], end[k, 1], end[k, 2], end[k, 3] = xi, yi, zi, e
             k += 1
-        px, py, pz, pe = x[i], y[i], z[i], e
+        px, py, pz, pe = xi, yi, zi, e
     return idx, (start[:m] if chained else start), end, chained
+
+
+def units_of(column) -> tuple[np.ndarray, float]:
+    """A column as the compiled loops read it: decimal units and their scale (``10**places``), or its values
+    and 0."""
+    if isinstance(column, DecimalColumn):
+        return column.units, 10.0 ** column.places
+    return np.asarray(column, float), 0.0
+
+
+def runs_of(column) -> tuple[np.ndarray, np.ndarray]:
+    """A column as the compiled loops read it: its values, and where its runs start (none for an array; one
+    run for a zero-stride view)."""
+    if isinstance(column, RunColumn):
+        return np.asarray(column.values, float), column.starts.astype(np.int64)
+    if np.asarray(column).strides == (0,) and len(column):
+        return np.asarray(column[:1], float).copy(), np.zeros(1, np.int64)
+    return np.asarray(column, float), NO_RUNS
+
+
+NO_RUNS = np.zeros(0, np.int64)  # a column read as it is
 
 
 def _marlin_trapezoids(move_d, accel, entry_v2, nominal_v2, exit_v2, start_v, cruise_v, end_v, accel_t, cruise_t,

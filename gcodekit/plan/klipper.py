@@ -25,8 +25,7 @@ import numpy as np
 from ..columns import Column, GatheredColumn, GrowingRuns, RunColumn, stored
 from ..errors import ConfigError
 from ..memory import release_freed_memory
-from ..parse.table import DecimalColumn
-from .kernels import engine
+from .kernels import NO_RUNS, engine, runs_of, units_of
 from .moves import (PlannedMoves, PlannerMoves, PlanResult, StepSetting, command_rows, firmware_moves, happens_before,
                     in_force, speed_factor)
 from .points import RunningSum
@@ -274,12 +273,12 @@ def _compiled_moves(compiled, moves, rows, limits, config, flush) -> tuple[dict,
     else:  # the extruder's running sum made as the loop goes, when it is not made already
         x, y, z, e = ends.columns
         summing = isinstance(e, RunningSum)
-        (x, x_scale), (y, y_scale), (e, e_scale) = (_units(c) for c in (x, y, e.deltas if summing else e))
-        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, x, y, *_runs(z), e, np.array([x_scale, y_scale, e_scale]),
+        (x, x_scale), (y, y_scale), (e, e_scale) = (units_of(c) for c in (x, y, e.deltas if summing else e))
+        points = (np.zeros((0, 4)), np.zeros((0, 4)), True, x, y, *runs_of(z), e, np.array([x_scale, y_scale, e_scale]),
                   summing, ends.idx, ends.chained)
     if ends is not None and moves.read_from_source:  # each move's speed and row read at its waypoint, in the loop
         src = moves.source
-        speeds_and_rows = (np.zeros(0), np.zeros(0, np.int32), True, *_runs(src.feed), src.command,
+        speeds_and_rows = (np.zeros(0), np.zeros(0, np.int32), True, *runs_of(src.feed), src.command,
                            src.motion, np.nan if src.rapid_v is None else float(src.rapid_v),
                            np.zeros(0) if src.factor is None else np.asarray(src.factor, float))
     else:
@@ -314,27 +313,6 @@ def _pseudo_accel(moves: PlannerMoves, rows: np.ndarray, limits: dict, config: K
         if runs is None:
             blocks.append(values)
     return runs.finish() if runs is not None else np.concatenate(blocks)
-
-
-NO_RUNS = np.zeros(0, np.int64)  # a column read as it is
-
-
-def _runs(column: Column) -> tuple[np.ndarray, np.ndarray]:
-    """A column as the compiled loop reads it: its values, and where its runs start (:data:`NO_RUNS` for an
-    array)."""
-    if isinstance(column, RunColumn):
-        return np.asarray(column.values, float), column.starts.astype(np.int64)
-    if np.asarray(column).strides == (0,) and len(column):  # one value: one run
-        return np.asarray(column[:1], float).copy(), np.zeros(1, np.int64)
-    return np.asarray(column, float), NO_RUNS
-
-
-def _units(column: Column | DecimalColumn) -> tuple[np.ndarray, float]:
-    """A column as the compiled loop reads it: decimal units and their scale (``10**places``), or its values
-    and 0."""
-    if isinstance(column, DecimalColumn):
-        return column.units, 10.0 ** column.places
-    return np.asarray(column, float), 0.0
 
 
 def _move_block(moves, rows, limits, config, flush, lo, hi, m, junction) -> None:

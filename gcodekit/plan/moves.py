@@ -21,7 +21,7 @@ import numpy as np
 from ..columns import Column, GatheredColumn, stored
 from ..emulate import arcs
 from ..parse.table import MOTION_RAPID, NAME_ID, in_ids
-from .kernels import engine
+from .kernels import engine, runs_of, units_of
 from .points import MoveEnds, RunningSum, chained
 
 if TYPE_CHECKING:
@@ -401,13 +401,16 @@ def firmware_moves(op: "EmulatedProgram", speed_factor: np.ndarray | None = None
     # length and time are unknown, and firmware time estimates leave them out.
     homing = in_ids(op.table.name[rows], [NAME_ID["home"], NAME_ID["home_secondary"]])
     compiled = engine(n)
-    # columns kept compactly (decimal units, runs) are read where needed, or decoded here for a moment: the
+    # columns kept compactly (decimal units, runs) are read as they are, or decoded here for a moment: the
     # operation keeps them compact, and the planner's own arrays come after these
     points = tuple(stored(w, k) for k in ("x", "y", "z"))
     e = np.cumsum(stored(w, "de")) if compiled is None else None
     if compiled is not None:  # the same moves and points in one loop, without the temporaries below
-        idx, start, end, is_chained = compiled.move_points(*(np.asarray(c) for c in points), np.asarray(stored(w, "de")),
-                                                           w["motion"], homing, w["distance"], not gathered)
+        (x, x_scale), (y, y_scale), (de, de_scale) = (units_of(stored(w, k)) for k in ("x", "y", "de"))
+        idx, start, end, is_chained = compiled.move_points(x, y, *runs_of(points[2]), de,
+                                                           np.array([x_scale, y_scale, de_scale]), w["motion"], homing,
+                                                           w["distance"], not gathered)
+        del x, y, de
         idx = _narrow(idx, n)
     else:
         points = tuple(np.asarray(c) for c in points)

@@ -117,7 +117,7 @@ class PlannedTimes:
             inside = waypoint[(waypoint >= lo) & (waypoint < hi)]
             has_moves[inside - lo] = True
             return self._summed[lo:hi].copy(), has_moves
-        first, stop = (int(k) for k in np.searchsorted(waypoint, (lo, hi)))
+        first, stop = (int(k) for k in np.searchsorted(waypoint, np.array((lo, hi), waypoint.dtype)))  # (no cast)
         sel = slice(first, stop)
         times = np.bincount(waypoint[sel] - lo, weights=self.result.durations(sel), minlength=hi - lo).astype(float, copy=False)
         has_moves = np.zeros(hi - lo, bool)
