@@ -91,6 +91,10 @@ _ERROR_TYPES: dict[str, type[GcodeError]] = {
 }
 
 
+#: How many of a program's first lines :attr:`Diagnostics.unreadable_lines` follows
+HEAD_LINES = 10_000
+
+
 class Diagnostics:
     """Collects diagnostics for one program; raises in strict mode.
 
@@ -124,6 +128,9 @@ class Diagnostics:
         #: Line numbers standing for lines of other files (subroutine files): number -> (file, line)
         self.elsewhere: dict[int, tuple[str, int]] = {}
         self._first_error: tuple[str, Diagnostic] | None = None  # (kind, diagnostic), for raise_first
+        #: The lines among the program's first :data:`HEAD_LINES` with an error in reading them (syntax or an
+        #: expression), listed or not
+        self.unreadable_lines: set[int] = set()
 
     def report(
         self,
@@ -149,6 +156,8 @@ class Diagnostics:
             raise _ERROR_TYPES[kind](message, diag)
         if severity == "error" and self._first_error is None:
             self._first_error = (kind, diag)
+        if severity == "error" and kind in ("syntax", "expression") and file == self.file and line <= HEAD_LINES:
+            self.unreadable_lines.add(line)
         key = (severity, message)
         seen = self._seen[key] = self._seen.get(key, 0) + 1
         if seen > self.repeats:

@@ -553,3 +553,39 @@ def test_a_relative_s_unknown_codes_alone_give_no_hint(shared_dir):
     assert _hints(on_marlin) == []
     on_grbl = _hints(gcodekit.gcode_to_operation(cube, "grbl", plan=False))
     assert len(on_grbl) == 1 and on_grbl[0].message.startswith("the program looks written for 'prusa'")
+
+
+UNREADABLE = "could not be read (each has an error below): the summary describes only the rest"
+
+
+def test_a_text_that_is_no_program_says_so_first():
+    # a markdown note: lines 1 and 3-6 have errors (a '#' expression, words without numbers), line 2 is blank
+    text = "# Notes\n\nThese are notes about the shop, not a program.\n| tool | size |\n| --- | --- |\n| T1 | 6 mm |\n"
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+    first = op.diagnostics.items[0]
+    assert (first.severity, first.line) == ("warning", 1)
+    assert first.message.startswith(f"5 of its 6 lines {UNREADABLE}")
+
+
+def test_unreadable_lines_are_counted_listed_or_not():
+    # the same error on every line: 21 listed, the rest counted into a summary; every line counts
+    text = "".join(f"G1 X{i} F100 (cut)\n" for i in range(1000))
+    op = gcodekit.gcode_to_operation(text, flavor="marlin", plan=False)
+    assert op.diagnostics.items[0].message.startswith(f"1,000 of its 1,000 lines {UNREADABLE}")
+    longer = gcodekit.gcode_to_operation(text * 12, flavor="marlin", plan=False)  # 12,000 lines: the head counts
+    assert longer.diagnostics.items[0].message.startswith(f"10,000 of its first 10,000 lines {UNREADABLE}")
+
+
+@pytest.mark.parametrize("bad, good", [(2, 0), (4, 4), (3, 10)])
+def test_a_program_with_a_few_unreadable_lines_gets_no_such_note(bad, good):
+    # two bad lines are too few to say so; half the lines, or fewer, are a program with errors, not a text
+    text = "G21 G90\n" * good + "G1 X1 F100 Q\n" * bad
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+    assert op.diagnostics.has_error
+    assert not any(UNREADABLE in d.message for d in op.diagnostics.items)
+
+
+def test_three_of_five_lines_unreadable_is_said():
+    text = "G21 G90\nG1 X1 F100\n" + "G1 X1 F100 Q\n" * 3
+    op = gcodekit.gcode_to_operation(text, "linuxcnc", plan=False)
+    assert op.diagnostics.items[0].message.startswith(f"3 of its 5 lines {UNREADABLE}")

@@ -39,8 +39,8 @@ from ..plan import planner_settings, run_planner, times_every_move, times_to_pla
 from ..read import Blocks
 from ..syntax import Flavor
 from .assemble import WaypointJoiner, empty_table, new_machine, raise_first_run, warn_implausible_time
-from .program import (Program, as_program, check_program_end, note_other_dialect, note_weak_detection, progress_bar,
-                      quote_diagnostics, resolve)
+from .program import (Program, as_program, check_program_end, note_other_dialect, note_unreadable, note_weak_detection,
+                      progress_bar, quote_diagnostics, resolve)
 from .source import program_blocks, restore_line_numbers
 
 if TYPE_CHECKING:
@@ -148,6 +148,7 @@ def gcode_to_operation(source: str | os.PathLike, machine: str | MachineConfig |
             op.diagnostics = diagnostics
         if detection is None:  # the flavor was given, or came with the machine
             note_other_dialect(program, fl, op.diagnostics, machine=None if flavor is not None else config.name)
+        note_unreadable(op.diagnostics, op.n_lines)
         if plan and config.planner:
             settings = planner_settings(config.planner, config.planner_settings, machine_config)
             if config.planner == "marlin" and machine_config is None:

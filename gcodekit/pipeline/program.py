@@ -16,13 +16,14 @@ from pathlib import Path
 from typing import Iterator
 
 from ..emulate.presets import MachineConfig, default_machine_for, load_machine, machine_named_in, with_options
-from ..errors import Diagnostics
+from ..errors import HEAD_LINES, Diagnostics
 from ..parse import CommandTable
 from ..parse.table import NAME_ID
 from ..read import iter_lines
 from ..syntax import Detection, Flavor, detect_flavor, load_flavor
 
-__all__ = ["Program", "as_program", "resolve", "note_weak_detection", "note_other_dialect", "check_program_end",
+__all__ = ["Program", "as_program", "resolve", "note_weak_detection", "note_other_dialect", "note_unreadable",
+           "check_program_end",
            "quote_diagnostics", "progress_bar"]
 
 _PROGRAM_SUFFIXES = (".gcode", ".gco", ".g", ".nc", ".ngc", ".tap", ".cnc", ".gz", ".txt")
@@ -149,6 +150,20 @@ def note_other_dialect(program: Program, flavor: Flavor, diagnostics: Diagnostic
     diagnostics.report_first(1, 1, f"the program looks written for {name!r} ({'; '.join(detection.evidence)}), but "
                              f"was read as {flavor.name!r} ({read_as}): {found} may come from that; to read it "
                              f"as {name!r}, give {advice}", severity=severity)
+
+
+def note_unreadable(diagnostics: Diagnostics, n_lines: int) -> None:
+    """A warning, ahead of the others, when most of a file's lines could not be read (a text file, a table,
+    another language, codes of a dialect the flavor lacks): its summary describes only the little that could.
+
+    Lines are counted among the first :data:`~gcodekit.errors.HEAD_LINES`, whether their errors are listed
+    or counted into a summary."""
+    unreadable, head = len(diagnostics.unreadable_lines), min(n_lines, HEAD_LINES)
+    if unreadable >= 3 and 2 * unreadable > head:
+        lines = f"its {head:,} lines" if head == n_lines else f"its first {head:,} lines"
+        diagnostics.report_first(1, 1, f"{unreadable:,} of {lines} could not be read (each has an error below): the "
+                                 "summary describes only the rest; is the file a G-code program, in a dialect "
+                                 "gcodekit reads (--flavor)?", severity="warning")
 
 
 def check_program_end(program: Program, table: CommandTable, n_lines: int, diagnostics: Diagnostics) -> None:
