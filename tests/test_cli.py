@@ -191,6 +191,34 @@ def test_a_terminated_report_ends_its_chromium_and_leaves_no_profile(tmp_path):
         shutil.rmtree(temp)
 
 
+def test_a_report_terminated_while_its_forked_child_draws_leaves_nothing_running(tmp_path):
+    """The SIGTERM comes once the report has forked the child that draws its pictures: the command ends it
+    too, so nothing holds the command's output open (before, the child drew on for a minute, orphaned)."""
+    import signal
+    import time
+
+    import pytest
+
+    if not sys.platform.startswith("linux"):
+        pytest.skip("reports fork on Linux only")
+    big = tmp_path / "big.gcode"
+    big.write_text("G21\nG90\nM83\n" + "G1 X10 Y0 E0.1 F1800\nG1 X10 Y10 E0.1\nG1 X0 Y10 E0.1\nG1 X0 Y0 E0.1\n"
+                   * 250_000)
+    with subprocess.Popen([sys.executable, "-m", "gcodekit.cli", "report", str(big), "-o", str(tmp_path / "out"),
+                           "--no-progress", "--no-pdf"], stdout=subprocess.PIPE, stderr=subprocess.PIPE) as proc:
+        children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children")
+        child = None
+        while proc.poll() is None and child is None:  # the forked child: a python process of the command's
+            child = next((k for k in children.read_text().split()
+                          if b"python" in Path(f"/proc/{k}/cmdline").read_bytes()), None)
+            time.sleep(0.02)
+        assert child is not None, "the report ended before it forked"
+        proc.send_signal(signal.SIGTERM)
+        proc.communicate(timeout=60)  # returns once no process holds the output: the child is gone too
+    assert proc.returncode == 128 + signal.SIGTERM
+    assert not Path(f"/proc/{child}").exists()
+
+
 @pytest.mark.parametrize("environment, advice", [({}, False), ({"NUMPY_MADVISE_HUGEPAGE": "1"}, True)])
 def test_the_command_turns_numpy_s_huge_page_advice_off_unless_the_environment_chose(environment, advice):
     """The command (``cli.run``) sets NUMPY_MADVISE_HUGEPAGE=0 before NumPy is imported, so NumPy in the

@@ -95,3 +95,21 @@ def test_an_error_that_does_not_pickle_comes_back_as_its_text(fork_here):
 def test_a_child_that_dies_is_an_error(fork_here):
     with pytest.raises(RuntimeError, match="died"):
         Forked(lambda: os._exit(3)).result()
+
+
+def test_a_child_still_drawing_is_ended_with_the_process(fork_here, monkeypatch):
+    """The exit handlers (which a SIGTERM to the command runs) kill a child still at work, so that a stopped
+    report leaves nothing running that holds its output open; a child waited for is not touched."""
+    import signal
+    import time
+
+    done = Forked(lambda: 6 * 7)
+    assert done.result() == 42 and not forked._running
+    busy = Forked(lambda: time.sleep(60))
+    assert forked._running == {busy._pid}
+    reaped, waitpid = [], os.waitpid
+    monkeypatch.setattr(os, "waitpid", lambda pid, flags: reaped.append(waitpid(pid, flags)) or reaped[-1])
+    forked._end_children()
+    ((pid, status),) = reaped
+    assert pid == busy._pid and os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGKILL
+    assert not forked._running

@@ -15,14 +15,20 @@ process instead, with the same result.
 
 from __future__ import annotations
 
+import atexit
 import os
 import pickle
+import signal
 import sys
 import threading
 import traceback
 from typing import Callable, Generic, TypeVar
 
 T = TypeVar("T")
+
+#: The children forked and not yet waited for: ended with the process (a report stopped by a signal must not
+#: leave its child drawing, holding the command's output open)
+_running: set[int] = set()
 
 
 def can_fork() -> bool:
@@ -61,6 +67,7 @@ class Forked(Generic[T]):
             finally:
                 os._exit(status)
         os.close(send)
+        _running.add(self._pid)
 
     def result(self) -> T:
         """The child's result (read before waiting for it: a large one would fill the pipe and block it)."""
@@ -68,6 +75,7 @@ class Forked(Generic[T]):
             with os.fdopen(self._receive, "rb") as stream:
                 message = stream.read()
             _, status = os.waitpid(self._pid, 0)
+            _running.discard(self._pid)
             if not message:
                 raise RuntimeError(f"the forked process drawing the report died (wait status {status})")
             self._done = pickle.loads(message)
@@ -75,6 +83,21 @@ class Forked(Generic[T]):
         if not ok:
             raise value  # type: ignore[misc]
         return value  # type: ignore[return-value]
+
+
+def _end_children() -> None:
+    """Kill and reap the children still drawing: the process ends (its exit handlers run, as after a SIGTERM
+    the command turns into an exit) without waiting for their pictures."""
+    while _running:
+        pid = _running.pop()
+        try:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+        except (ProcessLookupError, ChildProcessError):  # ended and reaped already
+            pass
+
+
+atexit.register(_end_children)
 
 
 def _outcome(work: Callable[[], T]) -> tuple[bool, object]:
