@@ -6,6 +6,8 @@ times over millions of waypoints.  Stored as their runs (where each run
 starts, and its value: :class:`RunColumn`), such a column takes a few
 hundred kilobytes instead of 25 MB; a plan's move lengths are mostly their
 waypoints' distances (:class:`GatheredColumn` keeps the exceptions).
+Both, and the decimal units and planned times stored elsewhere, are read
+as arrays through :class:`ColumnReader`.
 :class:`Waypoints` is the mapping an operation keeps its columns in:
 reading a column gives it as an array, decoded on the first read and kept
 so from then on; :meth:`Waypoints.stored` gives what is stored, which a
@@ -23,10 +25,66 @@ import numpy as np
 
 from .growing import GrowingColumn
 
-__all__ = ["RunColumn", "GatheredColumn", "GrowingRuns", "Waypoints", "Column", "stored", "same_bits", "run_starts"]
+__all__ = ["ColumnReader", "RunColumn", "GatheredColumn", "GrowingRuns", "Waypoints", "Column", "stored", "same_bits", "run_starts"]
 
 
-class RunColumn:
+class ColumnReader:
+    """What a column stored another way shares: indexed like the 1-D array of ``size`` values of ``dtype`` it
+    stands for, and given whole by ``np.asarray``.
+
+    A subclass gives :meth:`window` (the values ``lo`` to ``hi - 1``) and,
+    where it can gather indices without the whole column, :meth:`_take`.
+    """
+
+    size: int
+    dtype: np.dtype
+
+    @property
+    def shape(self) -> tuple[int]:
+        return (self.size,)
+
+    @property
+    def ndim(self) -> int:
+        return 1
+
+    def __len__(self) -> int:
+        return self.size
+
+    def window(self, lo: int, hi: int) -> np.ndarray:
+        raise NotImplementedError
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        out = self.window(0, self.size)
+        return out if dtype is None else out.astype(dtype, copy=False)
+
+    def __getitem__(self, index) -> np.ndarray | np.generic:
+        if isinstance(index, slice):
+            lo, hi, step = index.indices(self.size)
+            return self.window(lo, hi) if step == 1 else np.asarray(self)[index]
+        if isinstance(index, (int, np.integer)):
+            k = int(index) + (self.size if index < 0 else 0)
+            if not 0 <= k < self.size:
+                raise IndexError(f"index {int(index)} is out of bounds for a column of {self.size}")
+            return self.window(k, k + 1)[0]
+        return self._take(np.asarray(index))
+
+    def _take(self, index: np.ndarray) -> np.ndarray:
+        """The values at ``index`` (indices or a mask), as the array would give them."""
+        return np.asarray(self)[index]
+
+    def _indices(self, index: np.ndarray) -> np.ndarray:
+        """``index`` as indices from 0 (a mask's places, negative ones counted from the end), checked."""
+        if index.dtype == bool:
+            if index.shape != self.shape:
+                raise IndexError(f"a mask of {index.shape} for a column of {self.size}")
+            index = np.flatnonzero(index)
+        index = np.where(index < 0, index + self.size, index)
+        if index.size and (int(index.min()) < 0 or int(index.max()) >= self.size):
+            raise IndexError(f"indices out of bounds for a column of {self.size}")
+        return index
+
+
+class RunColumn(ColumnReader):
     """A column of ``size`` values stored as runs: run ``k`` holds ``values[k]`` from ``starts[k]`` on.
 
     Indexed like a 1-D array (an int, a slice of step 1, indices or a
@@ -46,35 +104,30 @@ class RunColumn:
         self.starts, self.values, self.size = starts, values, int(size)
 
     @classmethod
+    def of_runs(cls, starts: np.ndarray, values: np.ndarray, size: int) -> "Column":
+        """The column of these runs: a zero-stride view of a lone value (no view of ``values``), else a
+        RunColumn (its starts as int32 when they fit)."""
+        if values.size == 1:
+            return np.broadcast_to(values[0], (size,))
+        return cls(starts.astype(np.int32) if size < 2**31 else starts, values, size)
+
+    @classmethod
     def encode(cls, values: np.ndarray, min_values_per_run: int = 8) -> "Column":
         """``values`` as runs when each run holds ``min_values_per_run`` values on average (a zero-stride view
         for a lone value), else the array itself."""
         starts = run_starts(values)
-        if starts.size <= 1:
-            return np.broadcast_to(values[0], values.shape) if values.size else values  # (no view of values)
-        if starts.size * min_values_per_run > values.size:
+        if values.size == 0 or (starts.size > 1 and starts.size * min_values_per_run > values.size):
             return values
-        return cls(starts.astype(np.int32) if values.size < 2**31 else starts, values[starts], values.size)
+        return cls.of_runs(starts, values[starts], values.size)
 
     @property
     def dtype(self) -> np.dtype:
         return self.values.dtype
 
     @property
-    def shape(self) -> tuple[int]:
-        return (self.size,)
-
-    @property
-    def ndim(self) -> int:
-        return 1
-
-    @property
     def nbytes(self) -> int:
         """The memory the runs take (an array of the values would take ``size * itemsize``)."""
         return int(self.starts.nbytes + self.values.nbytes)
-
-    def __len__(self) -> int:
-        return self.size
 
     def __repr__(self) -> str:
         return f"RunColumn({self.size} values in {self.values.size} runs, {self.dtype})"
@@ -93,36 +146,17 @@ class RunColumn:
         first, lengths = self._lengths(lo, hi)
         return np.repeat(self.values[first:first + lengths.size], lengths)
 
-    def __array__(self, dtype=None, copy=None) -> np.ndarray:
-        out = self.window(0, self.size)
-        return out if dtype is None else out.astype(dtype, copy=False)
-
-    def __getitem__(self, index) -> np.ndarray | np.generic:
-        if isinstance(index, slice):
-            lo, hi, step = index.indices(self.size)
-            return self.window(lo, hi) if step == 1 else np.asarray(self)[index]
-        if isinstance(index, (int, np.integer)):
-            k = int(index) + (self.size if index < 0 else 0)
-            if not 0 <= k < self.size:
-                raise IndexError(f"index {int(index)} is out of bounds for a column of {self.size}")
-            return self.values[np.searchsorted(self.starts, k, side="right") - 1]
-        index = np.asarray(index)
-        if index.dtype == bool:
-            if index.shape != self.shape:
-                raise IndexError(f"a mask of {index.shape} for a column of {self.size}")
-            index = np.flatnonzero(index)
+    def _take(self, index: np.ndarray) -> np.ndarray:
+        index = self._indices(index)
         if index.size == 0:
             return np.empty(index.shape, self.dtype)
-        index = np.where(index < 0, index + self.size, index)
         lo, hi = int(index.min()), int(index.max()) + 1
-        if lo < 0 or hi > self.size:
-            raise IndexError(f"indices out of bounds for a column of {self.size}")
         if hi - lo <= 4 * index.size:  # a block of nearby indices: the window, then gathered
             return self.window(lo, hi)[index - lo]
         return self.values[np.searchsorted(self.starts, index, side="right") - 1]
 
 
-class GatheredColumn:
+class GatheredColumn(ColumnReader):
     """A column that repeats another at given places but for a few: ``source[index]``, with ``values`` at
     ``rows`` (sorted) instead.
 
@@ -141,11 +175,12 @@ class GatheredColumn:
         where more than a fraction ``most`` of it differs."""
         if not (isinstance(source, np.ndarray) and source.dtype == column.dtype and index.size == column.size):
             return column
-        rows = []
+        rows, own = [], 0
         for lo in range(0, column.size, block):
             differ = np.flatnonzero(bits(column[lo:lo + block]) != bits(source[index[lo:lo + block]]))
             rows.append(differ + lo)
-            if sum(r.size for r in rows) > most * column.size:
+            own += differ.size
+            if own > most * column.size:
                 return column
         rows = np.concatenate(rows) if rows else np.zeros(0, np.int64)
         return cls(source, index, rows, column[rows])
@@ -155,52 +190,27 @@ class GatheredColumn:
         return int(self.index.size)
 
     @property
-    def shape(self) -> tuple[int]:
-        return (self.size,)
-
-    @property
     def dtype(self) -> np.dtype:
         return self.source.dtype
-
-    @property
-    def ndim(self) -> int:
-        return 1
 
     @property
     def nbytes(self) -> int:
         """What it holds of its own (the index and the source are the plan's and the waypoints')."""
         return int(self.rows.nbytes + self.values.nbytes)
 
-    def __len__(self) -> int:
-        return self.size
-
     def __repr__(self) -> str:
         return f"GatheredColumn({self.size} values, {self.rows.size} of their own)"
 
-    def __array__(self, dtype=None, copy=None) -> np.ndarray:
-        out = self[0:self.size]
-        return out if dtype is None else out.astype(dtype, copy=False)
+    def window(self, lo: int, hi: int) -> np.ndarray:
+        """The values ``lo`` to ``hi - 1`` as an array."""
+        hi = max(hi, lo)
+        out = self.source[self.index[lo:hi]]
+        first, last = np.searchsorted(self.rows, (lo, hi))
+        out[self.rows[first:last] - lo] = self.values[first:last]
+        return out
 
-    def __getitem__(self, index) -> np.ndarray | np.generic:
-        if isinstance(index, slice):
-            lo, hi, step = index.indices(self.size)
-            if step != 1:
-                return np.asarray(self)[index]
-            out = self.source[self.index[lo:hi]]
-            first, last = np.searchsorted(self.rows, (lo, max(hi, lo)))
-            out[self.rows[first:last] - lo] = self.values[first:last]
-            return out
-        if isinstance(index, (int, np.integer)):
-            k = int(index) + (self.size if index < 0 else 0)
-            if not 0 <= k < self.size:
-                raise IndexError(f"index {int(index)} is out of bounds for a column of {self.size}")
-            return self[k:k + 1][0]
-        index = np.asarray(index)
-        if index.dtype == bool:
-            if index.shape != self.shape:
-                raise IndexError(f"a mask of {index.shape} for a column of {self.size}")
-            index = np.flatnonzero(index)
-        index = np.where(index < 0, index + self.size, index)
+    def _take(self, index: np.ndarray) -> np.ndarray:
+        index = self._indices(index)
         out = self.source[self.index[index]]
         at = np.minimum(np.searchsorted(self.rows, index), max(self.rows.size - 1, 0))
         own = (self.rows[at] == index) if self.rows.size else np.zeros(index.shape, bool)
@@ -267,12 +277,7 @@ class GrowingRuns:
 
     def finish(self) -> Column:
         """The column: a zero-stride view of a lone value, else its runs (start indices as int32 when they fit)."""
-        starts, values = self.starts.finish(), self.values.finish()
-        if values.size == 1:
-            return np.broadcast_to(values[0], (self.size,))
-        if self.size < 2**31:
-            starts = starts.astype(np.int32)
-        return RunColumn(starts, values, self.size)
+        return RunColumn.of_runs(self.starts.finish(), self.values.finish(), self.size)
 
 
 class Waypoints(MutableMapping):

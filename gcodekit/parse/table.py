@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..columns import ColumnReader
 from ..lathe_profile import LatheProfile
 from ..syntax.flavor import COMMANDS, code_label
 from .commands import COMMAND_CLASSES, Command, Kind
@@ -89,7 +90,7 @@ class SparseColumn:
 
 
 @dataclass
-class DecimalColumn:
+class DecimalColumn(ColumnReader):
     """A dense column of words written with at most ``places`` decimals, stored as int32 units.
 
     ``X12.345`` is 12345 units at 3 places.  The value read back is
@@ -110,31 +111,17 @@ class DecimalColumn:
         return int(self.units.size)
 
     @property
-    def shape(self) -> tuple[int]:
-        return (self.size,)
-
-    @property
     def dtype(self) -> np.dtype:
         """The values' dtype (float64; the units are int32)."""
         return np.dtype(np.float64)
 
     @property
-    def ndim(self) -> int:
-        return 1
-
-    @property
     def nbytes(self) -> int:
         return int(self.units.nbytes)
 
-    def __len__(self) -> int:
-        return self.size
-
-    def __array__(self, dtype=None, copy=None) -> np.ndarray:
-        out = self.dense()
-        return out if dtype is None else out.astype(dtype, copy=False)
-
     def __getitem__(self, index) -> np.ndarray | float:
-        """The values of the rows ``index`` (an int, a slice or indices), as float64."""
+        """The values of the rows ``index`` (an int, a slice or indices, as the units take them), as float64;
+        a Python float for an int."""
         units = self.units[index]
         if np.ndim(units) == 0:
             return float("nan") if units == self.NO_WORD else float(units / 10.0 ** self.places)

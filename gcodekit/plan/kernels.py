@@ -654,7 +654,7 @@ def runs_of(column) -> tuple[np.ndarray, np.ndarray]:
         return np.asarray(column.values, float), column.starts.astype(np.int64)
     if np.asarray(column).strides == (0,) and len(column):
         return np.asarray(column[:1], float).copy(), np.zeros(1, np.int64)
-    return np.asarray(column, float), NO_RUNS
+    return np.ascontiguousarray(column, float), NO_RUNS
 
 
 NO_RUNS = np.zeros(0, np.int64)  # a column read as it is

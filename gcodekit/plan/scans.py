@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..columns import Column, RunColumn
-from .kernels import engine
+from ..columns import Column
+from .kernels import NO_RUNS, engine, runs_of
 
 BLOCK = 4096
 
@@ -75,25 +75,15 @@ class Increments:
 
     def kernel_args(self) -> tuple:
         """What the compiled scans take after ``out``: move_d, accel and its runs, pseudo_accel and its runs, free."""
-        none, no_runs = np.zeros(0), np.zeros(0, np.int64)
-        args = [np.ascontiguousarray(self.move_d, float)]
-        for column in (self.accel, self.pseudo_accel):
-            if column is None:
-                args += [none, no_runs]
-            elif isinstance(column, RunColumn):
-                args += [np.asarray(column.values, float), column.starts.astype(np.int64)]
-            elif np.ndim(column) == 1 and np.shape(column)[0] and np.asarray(column).strides == (0,):  # one value
-                args += [np.asarray(column[:1], float).copy(), np.zeros(1, np.int64)]
-            else:
-                args += [np.ascontiguousarray(column, float), no_runs]
-        args.append(np.zeros(0, np.bool_) if self.free is None else np.ascontiguousarray(self.free, np.bool_))
-        return tuple(args)
+        pseudo = runs_of(self.pseudo_accel) if self.pseudo_accel is not None else (np.zeros(0), NO_RUNS)
+        free = np.zeros(0, np.bool_) if self.free is None else np.ascontiguousarray(self.free, np.bool_)
+        return np.ascontiguousarray(self.move_d, float), *runs_of(self.accel), *pseudo, free
 
 
 def _stored_args() -> tuple:
     """:meth:`Increments.kernel_args` when the increments are an array."""
-    none, no_runs = np.zeros(0), np.zeros(0, np.int64)
-    return none, none, no_runs, none, no_runs, np.zeros(0, np.bool_)
+    none = np.zeros(0)
+    return none, none, NO_RUNS, none, NO_RUNS, np.zeros(0, np.bool_)
 
 
 def forward_min(cap: np.ndarray, inc: np.ndarray | Increments, first: float = 0.0, *,

@@ -15,7 +15,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..columns import Column, RunColumn, stored
+from ..columns import Column, ColumnReader, RunColumn, stored
 from .moves import PlannedMoves, PlannerMoves, PlanResult
 from .trapezoids import TrapezoidPlan
 
@@ -24,7 +24,7 @@ __all__ = ["PlannedTimes", "waypoint_times", "times_to_plan"]
 BLOCK = 1 << 16  # waypoints computed at once
 
 
-class PlannedTimes:
+class PlannedTimes(ColumnReader):
     """Per-waypoint planned time from per-move results, computed when read (indexed like a 1-D array).
 
     A waypoint's time is the sum of its moves' durations; a waypoint that
@@ -56,37 +56,14 @@ class PlannedTimes:
 
     dtype = np.dtype(np.float64)
 
-    @property
-    def shape(self) -> tuple[int]:
-        return (self.size,)
-
-    @property
-    def ndim(self) -> int:
-        return 1
-
-    def __len__(self) -> int:
-        return self.size
-
     def __repr__(self) -> str:
         return f"PlannedTimes({self.size} waypoints, {self.waypoint.size} moves)"
 
     def __array__(self, dtype=None, copy=None) -> np.ndarray:
         out = np.empty(self.size)
-        for lo in range(0, self.size, BLOCK):
+        for lo in range(0, self.size, BLOCK):  # a block at a time: small temporaries
             out[lo:lo + BLOCK] = self.window(lo, min(lo + BLOCK, self.size))
         return out if dtype is None else out.astype(dtype, copy=False)
-
-    def __getitem__(self, index) -> np.ndarray | np.float64:
-        if isinstance(index, slice):
-            lo, hi, step = index.indices(self.size)
-            if step == 1:
-                return self.window(lo, hi)
-        elif isinstance(index, (int, np.integer)):
-            k = int(index) + (self.size if index < 0 else 0)
-            if not 0 <= k < self.size:
-                raise IndexError(f"index {int(index)} is out of bounds for {self.size} waypoints")
-            return self.window(k, k + 1)[0]
-        return np.asarray(self)[index]
 
     def window(self, lo: int, hi: int) -> np.ndarray:
         """The times of waypoints ``lo`` to ``hi - 1``."""
